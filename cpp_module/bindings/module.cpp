@@ -1,0 +1,138 @@
+// pybind11 bindings of the FemBspTet core: `FemBspTet._bsptet`. Converts and validates only; the
+// public Python API lives in FemBspTet/core.py. Messages name the expected array shapes.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include "bsptet/errors.h"
+#include "bsptet/mesh_check.h"
+#include "bsptet/predicates.h"
+
+namespace py = pybind11;
+using namespace bsptet;
+
+namespace {
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+std::vector<double> points_from(const DoubleArray& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error(std::string(name) + " must have shape (n, 3), got ndim " + std::to_string(a.ndim()));
+  return std::vector<double>(a.data(), a.data() + a.size());
+}
+
+std::vector<Index> indices_from(const IndexArray& a, const char* name, int cols_a, int cols_b = -1) {
+  const bool ok = a.ndim() == 2 && (a.shape(1) == cols_a || a.shape(1) == cols_b);
+  if (!ok && !(a.size() == 0))
+    throw py::value_error(std::string(name) + " must have shape (m, " + std::to_string(cols_a) +
+                          (cols_b > 0 ? " or " + std::to_string(cols_b) : std::string()) + ")");
+  std::vector<Index> out(static_cast<std::size_t>(a.size()));
+  const std::int64_t* d = a.data();
+  for (py::ssize_t i = 0; i < a.size(); ++i) {
+    if (d[i] < INT32_MIN || d[i] > INT32_MAX)
+      throw py::value_error(std::string(name) + " entry " + std::to_string(i) + " = " + std::to_string(d[i]) +
+                            " does not fit a 32-bit index");
+    out[static_cast<std::size_t>(i)] = static_cast<Index>(d[i]);
+  }
+  return out;
+}
+
+py::dict quality_dict(const QualityStats& q) {
+  py::dict d;
+  d["tets"] = q.tets;
+  d["min_dihedral_deg"] = q.min_dihedral_deg;
+  d["max_dihedral_deg"] = q.max_dihedral_deg;
+  d["p1_dihedral_deg"] = q.p1_dihedral_deg;
+  d["median_dihedral_deg"] = q.median_dihedral_deg;
+  d["max_radius_edge_ratio"] = q.max_radius_edge_ratio;
+  d["median_radius_edge_ratio"] = q.median_radius_edge_ratio;
+  d["dihedral_histogram"] = q.dihedral_histogram;
+  return d;
+}
+
+TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
+  TetMesh m;
+  m.xyz = points_from(points, "points");
+  m.tet = indices_from(tets, "tets", 4, 10);
+  m.nodes_per_tet = (tets.ndim() == 2 && tets.shape(1) == 10) ? 10 : 4;
+  return m;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_bsptet, m) {
+  m.doc() = "FemBspTet C++ core (private; use FemBspTet.core)";
+  m.attr("__version__") = FEMBSPTET_VERSION;
+
+  m.def(
+      "orient3d",
+      [](std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> c, std::array<double, 3> d) {
+        auto v = [](const std::array<double, 3>& p) { return Vec3{p[0], p[1], p[2]}; };
+        return to_int(orient3d(v(a), v(b), v(c), v(d)));
+      },
+      "Exact sign of det[b-a, c-a, d-a]: +1 when d is on the side of the right-hand normal of (a,b,c).");
+
+  m.def(
+      "tet_quality",
+      [](const DoubleArray& points, const IndexArray& tets) {
+        const TetMesh mesh = tetmesh_from(points, tets);
+        QualityStats q;
+        {
+          py::gil_scoped_release release;
+          q = tet_quality(mesh);
+        }
+        return quality_dict(q);
+      },
+      py::arg("points"), py::arg("tets"), "Dihedral angles and radius-edge ratios of a tet mesh.");
+
+  m.def(
+      "check_mesh",
+      [](const DoubleArray& surface_points, const IndexArray& surface_triangles, const DoubleArray& points,
+         const IndexArray& tets, int max_messages, bool compute_quality) {
+        SurfaceMesh s;
+        s.xyz = points_from(surface_points, "surface_points");
+        s.tri = indices_from(surface_triangles, "surface_triangles", 3);
+        const TetMesh mesh = tetmesh_from(points, tets);
+        MeshCheckOptions o;
+        o.max_messages = max_messages;
+        o.compute_quality = compute_quality;
+        MeshCheckReport r;
+        {
+          py::gil_scoped_release release;
+          r = check_mesh(s, mesh, o);
+        }
+        py::dict d;
+        d["valid"] = r.valid;
+        d["points"] = r.points;
+        d["tets"] = r.tets;
+        d["boundary_faces"] = r.boundary_faces;
+        d["interior_faces"] = r.interior_faces;
+        d["bad_indices"] = r.bad_indices;
+        d["nonfinite_points"] = r.nonfinite_points;
+        d["duplicate_points"] = r.duplicate_points;
+        d["unreferenced_points"] = r.unreferenced_points;
+        d["inverted_tets"] = r.inverted_tets;
+        d["flat_tets"] = r.flat_tets;
+        d["overshared_faces"] = r.overshared_faces;
+        d["same_orientation_faces"] = r.same_orientation_faces;
+        d["boundary_faces_off_surface"] = r.boundary_faces_off_surface;
+        d["boundary_faces_inward"] = r.boundary_faces_inward;
+        d["unpaired_boundary_edges"] = r.unpaired_boundary_edges;
+        d["miscovered_triangles"] = r.miscovered_triangles;
+        d["inconsistent_midnodes"] = r.inconsistent_midnodes;
+        d["volume_equal"] = r.volume_equal;
+        d["tet_volume"] = r.tet_volume;
+        d["surface_volume"] = r.surface_volume;
+        d["steiner_points"] = r.steiner_points;
+        d["boundary_steiner_points"] = r.boundary_steiner_points;
+        d["messages"] = r.messages;
+        if (compute_quality) d["quality"] = quality_dict(r.quality);
+        return d;
+      },
+      py::arg("surface_points"), py::arg("surface_triangles"), py::arg("points"), py::arg("tets"),
+      py::arg("max_messages") = 20, py::arg("compute_quality") = true,
+      "Checks a tet mesh against its closed input surface, exactly (see mesh_check.h).");
+}

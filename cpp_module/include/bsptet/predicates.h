@@ -1,0 +1,32 @@
+// FemBspTet core: the geometric predicates on double coordinates. The only sign authority for
+// double inputs: a floating-point filter with a proven error bound decides when it can; otherwise
+// the sign is computed exactly (ExactFloat). Results are exact for every finite input.
+//
+// Sign conventions (stated once):
+//  * orient3d(a, b, c, d) = sign(det[b - a, c - a, d - a]). POSITIVE when d lies on the side into
+//    which the right-hand normal (b - a) x (c - a) points; a positively oriented tet (a, b, c, d)
+//    has orient3d > 0. ZERO when the four points are coplanar.
+//  * orient2d(a, b, c) = sign((b - a) x (c - a)) on the 2D coordinates: POSITIVE when a, b, c turn
+//    counter-clockwise.
+//  * orient2d_projected(a, b, c, axis) drops coordinate `axis` (0 = x, 1 = y, 2 = z) and applies
+//    orient2d to the remaining pair in cyclic order: (y, z) for axis 0, (z, x) for 1, (x, y) for 2,
+//    so that a triangle with normal n projects positively exactly when n[axis] > 0.
+#pragma once
+
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+enum class Sign : int { kNegative = -1, kZero = 0, kPositive = 1 };
+
+inline int to_int(Sign s) { return static_cast<int>(s); }
+inline Sign opposite(Sign s) { return static_cast<Sign>(-static_cast<int>(s)); }
+
+Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+Sign orient2d_projected(const Vec3& a, const Vec3& b, const Vec3& c, int axis);
+
+/// Exact-only versions (no filter), for differential tests of the filters.
+Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int axis);
+
+}  // namespace bsptet
