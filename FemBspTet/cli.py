@@ -1,0 +1,282 @@
+"""The ``fembsptet`` command line.
+
+    fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--order 1|2] [--stats-json FILE]
+                   [--quiet]
+    fembsptet check SURFACE TETMESH [--json]
+
+Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
+mesh is not valid; 1 internal failure (or a feature that is not built yet); 130 interrupted.
+Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli``.
+"""
+
+import argparse
+import json
+import os
+import sys
+import time
+import traceback
+
+from . import __version__
+from .errors import BspTetError, InputError
+from .progress import Progress
+
+SURFACE_EXTENSIONS = (".off", ".stl", ".obj", ".ply")
+CAD_EXTENSIONS = (".step", ".stp", ".brep", ".brp", ".iges", ".igs")
+VOLUME_EXTENSIONS = (".vtu", ".msh", ".inp", ".node", ".ele", ".mesh")
+FREECAD_VOLUME_EXTENSIONS = (".unv", ".med", ".z88")
+
+# Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
+STATS_KEYS = (
+    "input_points",
+    "input_triangles",
+    "points",
+    "tets",
+    "steiner_points",
+    "boundary_steiner_points",
+    "bsp_nodes",
+    "convex_cells",
+    "min_dihedral_deg",
+    "max_dihedral_deg",
+    "max_radius_edge_ratio",
+    "seconds_total",
+    "seconds_by_stage",
+    "valid",
+)
+
+
+def _ext(path):
+    return os.path.splitext(path)[1].lower()
+
+
+def load_input(path, size=None):
+    """Reads a surface file or tessellates a CAD file. Returns a list of Surfaces (one per solid)."""
+    ext = _ext(path)
+    if ext in SURFACE_EXTENSIONS:
+        from .surface_io import read_surface
+
+        return [read_surface(path)]
+    if ext in CAD_EXTENSIONS:
+        from .cad_tessellation import tessellate_file
+
+        return tessellate_file(path, size=size)
+    raise InputError(
+        f"unknown input format '{ext or '(no extension)'}'; supported: "
+        + ", ".join(SURFACE_EXTENSIONS + CAD_EXTENSIONS),
+        where=path,
+    )
+
+
+def check_output_path(path):
+    """Fails early (before meshing) on an output format we cannot write."""
+    ext = _ext(path)
+    if ext not in VOLUME_EXTENSIONS + FREECAD_VOLUME_EXTENSIONS:
+        raise InputError(
+            f"unknown output format '{ext or '(no extension)'}'; supported: "
+            + ", ".join(VOLUME_EXTENSIONS + FREECAD_VOLUME_EXTENSIONS),
+            where=path,
+        )
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise InputError("the output directory does not exist", where=parent)
+
+
+def write_output(path, mesh, surface=None):
+    ext = _ext(path)
+    if ext in FREECAD_VOLUME_EXTENSIONS:
+        from .freecad_export import write_via_freecad
+
+        write_via_freecad(path, mesh)
+    else:
+        from .volume_io import write_tet_mesh
+
+        write_tet_mesh(path, mesh, surface)
+
+
+def read_volume(path):
+    ext = _ext(path)
+    if ext in FREECAD_VOLUME_EXTENSIONS:
+        from .freecad_export import read_via_freecad
+
+        return read_via_freecad(path)
+    if ext in VOLUME_EXTENSIONS:
+        from .volume_io import read_tet_mesh
+
+        return read_tet_mesh(path)
+    raise InputError(
+        f"unknown tet mesh format '{ext or '(no extension)'}'; supported: "
+        + ", ".join(VOLUME_EXTENSIONS + FREECAD_VOLUME_EXTENSIONS),
+        where=path,
+    )
+
+
+def _cmd_mesh(args):
+    progress = Progress(enabled=not args.quiet)
+    t0 = time.perf_counter()
+    for out in args.output:
+        check_output_path(out)
+    if args.size is not None and not (args.size > 0):
+        raise InputError(f"--size must be a positive length, got {args.size}")
+    progress("reading input")
+    surfaces = load_input(args.input, size=args.size)
+    from . import core
+
+    progress("tetrahedralizing")
+    try:
+        result = core.tetrahedralize(surfaces, options={"size": args.size, "order": args.order},
+                                     progress=progress)
+    finally:
+        progress.finish()
+    # Not reached until the core lands: core.tetrahedralize raises NotImplementedYetError.
+    mesh, stats = result
+    for out in args.output:
+        write_output(out, mesh)
+    stats["seconds_total"] = time.perf_counter() - t0
+    if args.stats_json:
+        from .atomic_file import atomic_output
+
+        with atomic_output(args.stats_json) as f:
+            json.dump(stats, f, indent=1)
+    print(json.dumps({k: stats.get(k) for k in STATS_KEYS}, indent=1))
+    if args.compare_tetgen:
+        print(_tetgen_table(surfaces, stats))
+    return 0
+
+
+def _tetgen_table(surfaces, stats):
+    """Our counts beside `tetgen -pY` on the same surface(s)."""
+    from .compare.tetgen_backend import run_tetgen, tetgen_available
+
+    if not tetgen_available():
+        return "tetgen is not installed: no comparison (run scripts/setup.sh)"
+    runs = [run_tetgen(s, "pY") for s in surfaces]
+    tg_points = sum(len(r.mesh.points) for r in runs)
+    tg_tets = sum(len(r.mesh.tets) for r in runs)
+    tg_steiner = sum(r.steiner_points for r in runs)
+    tg_seconds = sum(r.seconds for r in runs)
+    rows = [
+        ("", "FemBspTet", "tetgen -pY"),
+        ("points", stats["points"], tg_points),
+        ("tets", stats["tets"], tg_tets),
+        ("steiner points", stats["steiner_points"], tg_steiner),
+        ("seconds", f"{stats['seconds_total']:.3f}", f"{tg_seconds:.3f}"),
+    ]
+    return "\n".join(f"{a:<16s}{b!s:>12s}{c!s:>14s}" for a, b, c in rows)
+
+
+def _summary(report):
+    q = report.get("quality", {})
+    lines = [
+        f"valid: {report['valid']}",
+        f"points: {report['points']}  tets: {report['tets']}  boundary faces: "
+        f"{report['boundary_faces']}  steiner points: {report['steiner_points']} "
+        f"(boundary {report['boundary_steiner_points']})",
+        f"volume: tets {report['tet_volume']:.17g}  enclosed {report['surface_volume']:.17g}  "
+        f"equal: {report['volume_equal']}",
+    ]
+    if q:
+        lines.append(
+            f"dihedral angles: min {q['min_dihedral_deg']:.3f}  1% {q['p1_dihedral_deg']:.3f}  "
+            f"median {q['median_dihedral_deg']:.3f}  max {q['max_dihedral_deg']:.3f} deg;  "
+            f"max radius-edge ratio {q['max_radius_edge_ratio']:.4g}"
+        )
+    defects = [
+        k
+        for k in (
+            "bad_indices",
+            "nonfinite_points",
+            "duplicate_points",
+            "unreferenced_points",
+            "inverted_tets",
+            "flat_tets",
+            "overshared_faces",
+            "same_orientation_faces",
+            "boundary_faces_off_surface",
+            "boundary_faces_inward",
+            "unpaired_boundary_edges",
+            "miscovered_triangles",
+            "inconsistent_midnodes",
+        )
+        if report.get(k)
+    ]
+    for k in defects:
+        lines.append(f"  {k}: {report[k]}")
+    for m in report["messages"]:
+        lines.append(f"  - {m}")
+    return "\n".join(lines)
+
+
+def _cmd_check(args):
+    from . import core
+    from .surface_io import read_surface
+
+    if _ext(args.surface) not in SURFACE_EXTENSIONS:
+        raise InputError(
+            "the reference surface must be a triangle surface file ("
+            + ", ".join(SURFACE_EXTENSIONS) + ")",
+            where=args.surface,
+        )
+    surface = read_surface(args.surface)
+    mesh = read_volume(args.tetmesh)
+    report = core.check_mesh(surface, mesh, max_messages=args.max_messages)
+    if args.json:
+        json.dump(report, sys.stdout, indent=1)
+        sys.stdout.write("\n")
+    else:
+        print(_summary(report))
+    if not report["valid"]:
+        if not args.json:
+            print(f"fembsptet: {args.tetmesh} is NOT a valid mesh of {args.surface}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def build_parser():
+    p = argparse.ArgumentParser(
+        prog="fembsptet",
+        description="BSP-assisted constrained tetrahedralization for FEM (FreeCAD addon CLI).",
+    )
+    p.add_argument("--version", action="version", version=f"fembsptet {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    m = sub.add_parser("mesh", help="tetrahedralize a closed surface or CAD solid")
+    m.add_argument("input", help="surface (.off .stl .obj .ply) or CAD (.step .stp .brep .iges)")
+    m.add_argument("-o", "--output", action="append", required=True,
+                   help="output mesh; repeat for several (.vtu .msh .inp .node .mesh .unv .med .z88)")
+    m.add_argument("--size", type=float, default=None, help="maximum element size (edge length)")
+    m.add_argument("--order", type=int, choices=(1, 2), default=1, help="element order")
+    m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
+    m.add_argument("--quiet", action="store_true", help="no progress bar")
+    m.add_argument("--compare-tetgen", action="store_true",
+                   help="also run tetgen -pY on the same surface and print both side by side")
+    m.set_defaults(func=_cmd_mesh)
+
+    c = sub.add_parser("check", help="check a tet mesh against its surface (exit 0 only if valid)")
+    c.add_argument("surface", help="the closed input surface (.off .stl .obj .ply)")
+    c.add_argument("tetmesh", help="the tet mesh (.vtu .msh .inp .node/.ele .mesh .unv .med .z88)")
+    c.add_argument("--json", action="store_true", help="print the full report as JSON")
+    c.add_argument("--max-messages", type=int, default=20, help="problems listed (default 20)")
+    c.set_defaults(func=_cmd_check)
+    return p
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except InputError as exc:
+        print(f"fembsptet: error: {exc}", file=sys.stderr)
+        return 2
+    except BspTetError as exc:
+        print(f"fembsptet: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("fembsptet: interrupted; no output was written", file=sys.stderr)
+        return 130
+    except Exception:  # noqa: BLE001 - last resort: report and exit 1, never a bare traceback
+        print("fembsptet: internal error (please report it with the input):", file=sys.stderr)
+        traceback.print_exc()
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Comparison with other meshers (TetGen, Gmsh), run as separate programs."""
