@@ -26,6 +26,16 @@ double ExactFloat::to_double() const {
   return std::ldexp(d, static_cast<int>(exp2 + exp_));
 }
 
+mpq_class ExactFloat::to_mpq() const {
+  mpq_class q(mant_);
+  if (exp_ > 0)
+    mpz_mul_2exp(q.get_num_mpz_t(), q.get_num_mpz_t(), static_cast<mp_bitcnt_t>(exp_));
+  else if (exp_ < 0)
+    mpz_mul_2exp(q.get_den_mpz_t(), q.get_den_mpz_t(), static_cast<mp_bitcnt_t>(-exp_));
+  q.canonicalize();
+  return q;
+}
+
 namespace {
 // Aligns two numbers to the smaller exponent: returns mantissas scaled so that both share `e`.
 void align(const mpz_class& am, std::int64_t ae, const mpz_class& bm, std::int64_t be, mpz_class& ra,

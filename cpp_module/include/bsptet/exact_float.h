@@ -19,6 +19,8 @@ class ExactFloat {
   int sign() const { return sgn(mant_); }
   /// Nearest double (for reporting only; never used to decide).
   double to_double() const;
+  /// The exact value as a GMP rational.
+  mpq_class to_mpq() const;
 
   friend ExactFloat operator+(const ExactFloat& a, const ExactFloat& b);
   friend ExactFloat operator-(const ExactFloat& a, const ExactFloat& b);

@@ -1,0 +1,121 @@
+// FemBspTet core: the BSP as a conforming convex cell complex (paper Sec. 2.1-2.2: BSP tree and
+// convex decomposition; Sec. 2.2.1: BSP points).
+//
+// The complex starts as one cell, a box around the input, and is split recursively by the planes
+// of the input triangles (an auto-partition: coplanar triangles share one plane). Each cell keeps a
+// conflict list: the input triangles that may cross its interior (a conservative superset). A cell
+// whose list is empty is a leaf: every input triangle meeting it lies on its boundary.
+//
+// Conformity: a split cuts the crossing edges of the cell once, for every face that uses them, and
+// splits each crossing face for both cells that share it. So the complex never has a T-junction
+// hidden inside a face or an edge: the paper's "glue" and "crossed-edge fixing" problems cannot
+// arise (the crossing points p, q, r, s of its Fig. 9 are the vertices a face split creates).
+//
+// Orientation (stated once): a face's vertex cycle is counter-clockwise around its plane's normal n
+// (implicit_geometry.h). cell[0] lies on the positive side (n points into it), cell[1] on the
+// negative side; -1 means outside the bounding box.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "bsptet/implicit_geometry.h"
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+struct BspFace {
+  Index plane = -1;
+  std::vector<Index> verts;     ///< cyclic, CCW around the plane normal
+  Index cell[2] = {-1, -1};     ///< [0] positive side, [1] negative side, -1 outside the box
+  std::vector<Index> coplanar;  ///< input triangles on this plane that may overlap the face
+  bool alive = true;
+};
+
+struct BspCell {
+  std::vector<Index> faces;
+  std::vector<Index> conflict;  ///< input triangles that may cross the interior
+  bool alive = true;
+};
+
+struct BspStats {
+  std::int64_t splits = 0;          ///< internal BSP nodes
+  std::int64_t leaves = 0;          ///< convex cells
+  std::int64_t bsp_points = 0;      ///< vertices created by splits (TPI points)
+  std::int64_t planes = 0;          ///< distinct input planes
+};
+
+class BspComplex {
+ public:
+  /// The 8 corners of the bounding box, in bit order x + 2y + 4z; the caller appends them to the
+  /// explicit points after the input points.
+  static std::vector<Vec3> box_corners(const SurfaceMesh& surface);
+
+  /// `geo` holds the input points as explicit points 0..#P-1 with vertices of the same ids, and
+  /// the planes; `tri_plane[t]` is the plane of input triangle t.
+  BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane);
+
+  /// Splits until every cell is a leaf. `cancelled` is polled between splits.
+  void build(const std::function<bool()>& cancelled, const std::function<void(double)>& progress);
+
+  /// After build(): replaces every TPI vertex that coincides with an input point by that input
+  /// point's vertex (splits through input vertices create them: the input vertices are not
+  /// vertices of the complex until then). Exact: a rounded-coordinate lookup proposes, the three
+  /// defining planes confirm.
+  void identify_input_vertices();
+
+  /// After build(): splits every face that lies on an input plane until each one is inside a single
+  /// input triangle (or overlaps none). The covering triangle is then face.coplanar[0]. Splits run
+  /// along input edge lines inside the plane, for every face that uses the crossed edges.
+  void refine_covered_faces();
+
+  const std::vector<BspFace>& faces() const { return faces_; }
+  const std::vector<BspCell>& cells() const { return cells_; }
+  const BspStats& stats() const { return stats_; }
+  ImplicitGeometry& geometry() { return geo_; }
+  /// Vertex k of input triangle t (input point ids are vertex ids).
+  Index triangle_vertex(Index t, int k) const { return surface_.tri[3 * t + k]; }
+
+  /// Debug check of the combinatorics: every face's cells list it, every edge is used by faces
+  /// consistently, cells are closed. Throws MeshingError on a violation.
+  void check_consistency() const;
+  /// Run check_consistency() after every split (slow; for tests).
+  void set_debug_checks(bool on) { debug_checks_ = on; }
+
+ private:
+  static std::uint64_t edge_key(Index u, Index w) {
+    if (u > w) std::swap(u, w);
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
+  }
+  void make_box();
+  Index new_face(BspFace f);
+  void register_edges(Index f);
+  void unregister_edges(Index f);
+  Index choose_plane(Index c);
+  /// Splits cell c by plane p; returns false when p does not cut c's interior.
+  bool split_cell(Index c, Index p);
+  void split_edge(Index u, Index w, Index x);
+  /// The two distinct planes whose intersection is the line of edge (u, w).
+  std::array<Index, 2> edge_line(Index u, Index w) const;
+  void classify_triangle(Index t, Index p, int& mn, int& mx);
+  /// Exact: does the interior of face f overlap the interior of coplanar input triangle t?
+  bool face_overlaps_triangle(Index f, Index t, int axis, int face_orientation);
+  Index edge_plane(Index a, Index b, Index face_plane);
+  std::unordered_map<std::uint64_t, Index> edge_planes_;
+
+  ImplicitGeometry& geo_;
+  const SurfaceMesh& surface_;
+  std::vector<Index> tri_plane_;
+  std::vector<BspFace> faces_;
+  std::vector<BspCell> cells_;
+  std::unordered_map<std::uint64_t, std::vector<Index>> edge_faces_;
+  std::unordered_map<std::uint64_t, std::array<Index, 2>> edge_line_;
+  BspStats stats_;
+  bool debug_checks_ = false;
+  Index corner0_ = -1;  ///< vertex id of the first box corner
+};
+
+}  // namespace bsptet

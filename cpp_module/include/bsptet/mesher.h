@@ -1,0 +1,57 @@
+// FemBspTet core: the single entry point of the tetrahedralizer.
+//
+//   TetMesh tetrahedralize(const SurfaceMesh& surface, const MeshOptions& options, MeshStats* stats)
+//
+// Pipeline (paper section -> file):
+//   input check ................................ mesher.cpp (validate_surface)
+//   planes of the input triangles .............. mesher.cpp (group_planes): coplanar triangles share one
+//   2.1-2.2  BSP tree, convex cells ............ bsp_complex.cpp (conforming cell complex)
+//   2.2.1    BSP points ........................ bsp_complex.cpp (TPI vertices of edge splits)
+//   2.2      inside / outside .................. cell_classify.cpp (exact coverage + winding numbers)
+//   2.3      per-cell tetrahedralization ....... cell_tetrahedralize.cpp
+//   2.4/2.5  glue, crossed-edge fixing ......... not needed: the complex is conforming (bsp_complex.h)
+//   output   doubles, checked exactly .......... snap_round.cpp
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+struct MeshOptions {
+  /// Keep BSP points that lie on the input surface. The default output must have none (FEM loads
+  /// find nodes on CAD faces); until their removal is built, meshing with this false fails with a
+  /// clear error when such points remain.
+  bool allow_boundary_steiner = false;
+  /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
+  bool debug_checks = false;
+  /// Called with (stage, fraction in [0, 1]); may be empty.
+  std::function<void(const std::string&, double)> progress;
+  /// Polled between steps; return true to stop (throws an Error with code kCancelled).
+  std::function<bool()> cancelled;
+};
+
+struct MeshStats {
+  std::int64_t input_points = 0, input_triangles = 0, input_planes = 0;
+  std::int64_t points = 0, tets = 0, steiner_points = 0, boundary_steiner_points = 0;
+  std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
+  std::int64_t exact_fallbacks = 0;
+  std::map<std::string, double> seconds_by_stage;
+  double seconds_total = 0;
+};
+
+/// Checks the input surface: finite coordinates, indices in range, no degenerate or duplicate
+/// triangles, every edge shared by exactly two triangles in opposite directions. Throws InputError
+/// naming the first offending triangle or vertex.
+void validate_surface(const SurfaceMesh& surface);
+
+/// Tetrahedralizes the solid bounded by `surface`. Throws InputError for bad input, MeshingError
+/// (code kCancelled when cancelled) otherwise. Output: every input point first (same indices,
+/// unused ones dropped and the rest renumbered), then the Steiner points.
+TetMesh tetrahedralize(const SurfaceMesh& surface, const MeshOptions& options = {}, MeshStats* stats = nullptr);
+
+}  // namespace bsptet

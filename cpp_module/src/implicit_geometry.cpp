@@ -1,0 +1,229 @@
+#include "bsptet/implicit_geometry.h"
+
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "bsptet/errors.h"
+
+namespace bsptet {
+
+namespace {
+
+// Plane coefficients n = (b - a) x (c - a), d = n . a, in any exact-enough number type T.
+template <class T>
+void plane_coefficients(const Vec3& a, const Vec3& b, const Vec3& c, std::array<T, 3>& n, T& d) {
+  const T ax(a.x), ay(a.y), az(a.z);
+  const T ux = T(b.x) - ax, uy = T(b.y) - ay, uz = T(b.z) - az;
+  const T vx = T(c.x) - ax, vy = T(c.y) - ay, vz = T(c.z) - az;
+  n = {uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx};
+  d = n[0] * ax + n[1] * ay + n[2] * az;
+}
+
+template <class T>
+std::array<T, 3> cross(const T* p, const T* q) {
+  return {p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]};
+}
+
+// Homogeneous TPI: x = (d1 n2 x n3 + d2 n3 x n1 + d3 n1 x n2) / (n1 . n2 x n3).
+template <class T>
+std::array<T, 4> tpi(const T* n1, const T& d1, const T* n2, const T& d2, const T* n3, const T& d3) {
+  const auto c23 = cross(n2, n3), c31 = cross(n3, n1), c12 = cross(n1, n2);
+  std::array<T, 4> h;
+  for (int k = 0; k < 3; ++k) h[k] = d1 * c23[k] + d2 * c31[k] + d3 * c12[k];
+  h[3] = n1[0] * c23[0] + n1[1] * c23[1] + n1[2] * c23[2];
+  return h;
+}
+
+// side of homogeneous point h against plane (n, d): sign(n . X - d W) * sign(W)
+template <class T>
+T side_value(const T* nd, const std::array<T, 4>& h) {
+  return nd[0] * h[0] + nd[1] * h[1] + nd[2] * h[2] - nd[3] * h[3];
+}
+
+template <class T>
+T det3_homog(const std::array<T, 4>& p, const std::array<T, 4>& q, const std::array<T, 4>& r, int u, int v) {
+  // | p_u p_v p_w ; q_u q_v q_w ; r_u r_v r_w | with w = homogeneous weight (index 3)
+  return p[u] * (q[v] * r[3] - q[3] * r[v]) - p[v] * (q[u] * r[3] - q[3] * r[u]) +
+         p[3] * (q[u] * r[v] - q[v] * r[u]);
+}
+
+Sign to_sign(int s) { return s > 0 ? Sign::kPositive : (s < 0 ? Sign::kNegative : Sign::kZero); }
+
+}  // namespace
+
+ImplicitGeometry::ImplicitGeometry(std::vector<Vec3> explicit_points) : points_(std::move(explicit_points)) {}
+
+Index ImplicitGeometry::add_plane(Index a, Index b, Index c) {
+  const Index id = static_cast<Index>(planes_.size());
+  planes_.push_back({a, b, c});
+  plane_cache_.emplace_back();
+  if (projection_axis(id) < 0)
+    throw MeshingError(ErrorCode::kInternal, "geometry", id, "plane through collinear points");
+  return id;
+}
+
+Index ImplicitGeometry::add_explicit_point(const Vec3& p) {
+  points_.push_back(p);
+  return add_explicit_vertex(static_cast<Index>(points_.size() - 1));
+}
+
+Index ImplicitGeometry::add_explicit_vertex(Index point) {
+  Vertex v;
+  v.explicit_id = point;
+  verts_.push_back(std::move(v));
+  return static_cast<Index>(verts_.size() - 1);
+}
+
+Index ImplicitGeometry::add_tpi_vertex(Index p, Index q, Index r) {
+  Vertex v;
+  v.planes = {p, q, r};
+  v.on_planes = {p, q, r};
+  verts_.push_back(std::move(v));
+  return static_cast<Index>(verts_.size() - 1);
+}
+
+void ImplicitGeometry::note_on_plane(Index v, Index p) {
+  auto& on = verts_[v].on_planes;
+  if (std::find(on.begin(), on.end(), p) == on.end()) on.push_back(p);
+}
+
+void ImplicitGeometry::prepare_plane(Index p) {
+  PlaneCache& c = plane_cache_[p];
+  if (c.ready) return;
+  const PlaneDef& pd = planes_[p];
+  plane_coefficients<Interval>(points_[pd.a], points_[pd.b], points_[pd.c], c.n_iv, c.d_iv);
+  c.ready = true;
+}
+
+const std::array<ExactFloat, 4>& ImplicitGeometry::plane_exact(Index p) {
+  PlaneCache& c = plane_cache_[p];
+  if (!c.exact) {
+    const PlaneDef& pd = planes_[p];
+    std::array<ExactFloat, 3> n;
+    ExactFloat d;
+    plane_coefficients<ExactFloat>(points_[pd.a], points_[pd.b], points_[pd.c], n, d);
+    c.exact = std::make_unique<std::array<ExactFloat, 4>>(std::array<ExactFloat, 4>{n[0], n[1], n[2], d});
+  }
+  return *c.exact;
+}
+
+const std::array<Interval, 4>& ImplicitGeometry::vertex_interval(Index v) {
+  Vertex& vx = verts_[v];
+  if (!vx.iv_ready) {
+    if (vx.explicit_id >= 0) {
+      const Vec3& p = points_[vx.explicit_id];
+      vx.iv = {Interval(p.x), Interval(p.y), Interval(p.z), Interval(1.0)};
+    } else {
+      Interval nd[3][4];
+      for (int i = 0; i < 3; ++i) {
+        prepare_plane(vx.planes[i]);
+        const PlaneCache& c = plane_cache_[vx.planes[i]];
+        for (int k = 0; k < 3; ++k) nd[i][k] = c.n_iv[k];
+        nd[i][3] = c.d_iv;
+      }
+      vx.iv = tpi<Interval>(nd[0], nd[0][3], nd[1], nd[1][3], nd[2], nd[2][3]);
+    }
+    vx.iv_ready = true;
+  }
+  return vx.iv;
+}
+
+const std::array<ExactFloat, 4>& ImplicitGeometry::vertex_exact(Index v) {
+  Vertex& vx = verts_[v];
+  if (!vx.exact) {
+    std::array<ExactFloat, 4> h;
+    if (vx.explicit_id >= 0) {
+      const Vec3& p = points_[vx.explicit_id];
+      h = {ExactFloat(p.x), ExactFloat(p.y), ExactFloat(p.z), ExactFloat(1.0)};
+    } else {
+      const auto& a = plane_exact(vx.planes[0]);
+      const auto& b = plane_exact(vx.planes[1]);
+      const auto& c = plane_exact(vx.planes[2]);
+      h = tpi<ExactFloat>(a.data(), a[3], b.data(), b[3], c.data(), c[3]);
+      if (h[3].sign() == 0)
+        throw MeshingError(ErrorCode::kInternal, "geometry", v, "three planes without a common point");
+    }
+    vx.exact = std::make_unique<std::array<ExactFloat, 4>>(std::move(h));
+  }
+  return *vx.exact;
+}
+
+Sign ImplicitGeometry::side(Index p, Index v) {
+  const Vertex& vx = verts_[v];
+  for (Index q : vx.on_planes)
+    if (q == p) return Sign::kZero;
+  const PlaneDef& pd = planes_[p];
+  if (vx.explicit_id >= 0) {
+    if (vx.explicit_id == pd.a || vx.explicit_id == pd.b || vx.explicit_id == pd.c) return Sign::kZero;
+    return orient3d(points_[pd.a], points_[pd.b], points_[pd.c], points_[vx.explicit_id]);
+  }
+  prepare_plane(p);
+  const PlaneCache& c = plane_cache_[p];
+  const auto& h = vertex_interval(v);
+  const Interval nd[4] = {c.n_iv[0], c.n_iv[1], c.n_iv[2], c.d_iv};
+  const int s = side_value<Interval>(nd, h).certain_sign();
+  const int w = h[3].certain_sign();
+  if (s != 0 && w != 0) return to_sign(s * w);
+  ++exact_fallbacks_;
+  const auto& e = plane_exact(p);
+  const auto& he = vertex_exact(v);
+  const int se = side_value<ExactFloat>(e.data(), he).sign() * he[3].sign();
+  if (se == 0) note_on_plane(v, p);
+  return to_sign(se);
+}
+
+Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
+  const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c];
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0)
+    return orient2d_projected(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id], axis);
+  const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c);
+  const int s = det3_homog<Interval>(ha, hb, hc, u, v).certain_sign();
+  const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign();
+  if (s != 0 && w != 0) return to_sign(s * w);
+  ++exact_fallbacks_;
+  const auto &ea = vertex_exact(a), &eb = vertex_exact(b), &ec = vertex_exact(c);
+  return to_sign(det3_homog<ExactFloat>(ea, eb, ec, u, v).sign() * ea[3].sign() * eb[3].sign() * ec[3].sign());
+}
+
+int ImplicitGeometry::projection_axis(Index p, Sign* normal_sign) {
+  const PlaneDef& pd = planes_[p];
+  const Vec3 &a = points_[pd.a], &b = points_[pd.b], &c = points_[pd.c];
+  const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+  const double n[3] = {std::fabs(uy * vz - uz * vy), std::fabs(uz * vx - ux * vz), std::fabs(ux * vy - uy * vx)};
+  int order[3] = {0, 1, 2};
+  std::stable_sort(order, order + 3, [&](int i, int j) { return n[i] > n[j]; });
+  for (int axis : order) {
+    const Sign s = orient2d_projected(a, b, c, axis);
+    if (s != Sign::kZero) {
+      if (normal_sign) *normal_sign = s;
+      return axis;
+    }
+  }
+  return -1;
+}
+
+Vec3 ImplicitGeometry::rounded(Index v) {
+  const Vertex& vx = verts_[v];
+  if (vx.explicit_id >= 0) return points_[vx.explicit_id];
+  const auto& h = vertex_exact(v);
+  const mpq_class w = h[3].to_mpq();
+  double out[3];
+  for (int k = 0; k < 3; ++k) {
+    const mpq_class q = h[k].to_mpq() / w;
+    // Round to nearest: get_d truncates, so compare the neighbours exactly.
+    double best = q.get_d();
+    mpq_class best_err = abs(q - mpq_class(best));
+    for (double cand : {std::nextafter(best, -INFINITY), std::nextafter(best, INFINITY)}) {
+      const mpq_class err = abs(q - mpq_class(cand));
+      if (err < best_err) best = cand, best_err = err;
+    }
+    out[k] = best;
+  }
+  return {out[0], out[1], out[2]};
+}
+
+}  // namespace bsptet

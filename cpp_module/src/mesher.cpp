@@ -1,0 +1,250 @@
+#include "bsptet/mesher.h"
+
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+#include "bsptet/bsp_complex.h"
+#include "bsptet/cell_classify.h"
+#include "bsptet/cell_tetrahedralize.h"
+#include "bsptet/errors.h"
+#include "bsptet/exact_float.h"
+#include "bsptet/implicit_geometry.h"
+#include "bsptet/predicates.h"
+#include "bsptet/snap_round.h"
+
+namespace bsptet {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string tri_str(const SurfaceMesh& s, Index t) {
+  return "triangle " + std::to_string(t) + " (vertices " + std::to_string(s.tri[3 * t]) + " " +
+         std::to_string(s.tri[3 * t + 1]) + " " + std::to_string(s.tri[3 * t + 2]) + ")";
+}
+
+// Merges input points with identical coordinates (first index wins); returns the surface with
+// canonical indices.
+SurfaceMesh merge_coincident_points(const SurfaceMesh& in) {
+  std::map<std::array<double, 3>, Index> first;
+  std::vector<Index> canon(in.num_points());
+  for (Index i = 0; i < in.num_points(); ++i) {
+    std::array<double, 3> key = {in.xyz[3 * i] + 0.0, in.xyz[3 * i + 1] + 0.0, in.xyz[3 * i + 2] + 0.0};
+    canon[i] = first.emplace(key, i).first->second;
+  }
+  SurfaceMesh out = in;
+  for (auto& v : out.tri) v = canon[v];
+  return out;
+}
+
+// Groups the triangles by exact plane: a canonical rational key (the plane equation divided by
+// its first non-zero normal component) finds candidates, an exact orientation test confirms.
+std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
+  const Index nt = s.num_triangles();
+  std::vector<Index> tri_plane(nt, -1);
+  std::map<std::array<double, 4>, std::vector<std::pair<Index, Index>>> buckets;  // key -> (plane, tri)
+  for (Index t = 0; t < nt; ++t) {
+    const Index a = s.tri[3 * t], b = s.tri[3 * t + 1], c = s.tri[3 * t + 2];
+    const Vec3 pa = s.point(a), pb = s.point(b), pc = s.point(c);
+    const ExactFloat ax(pa.x), ay(pa.y), az(pa.z);
+    const ExactFloat ux = ExactFloat(pb.x) - ax, uy = ExactFloat(pb.y) - ay, uz = ExactFloat(pb.z) - az;
+    const ExactFloat vx = ExactFloat(pc.x) - ax, vy = ExactFloat(pc.y) - ay, vz = ExactFloat(pc.z) - az;
+    const ExactFloat n[3] = {uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx};
+    const ExactFloat d = n[0] * ax + n[1] * ay + n[2] * az;
+    int k = 0;
+    while (k < 3 && n[k].sign() == 0) ++k;
+    const mpq_class nk = n[k].to_mpq();
+    std::array<double, 4> key;
+    for (int i = 0; i < 3; ++i) key[i] = mpq_class(n[i].to_mpq() / nk).get_d();
+    key[3] = mpq_class(d.to_mpq() / nk).get_d();
+    auto& bucket = buckets[key];
+    Index plane = -1;
+    for (const auto& [p, rep] : bucket) {
+      const Vec3 ra = s.point(s.tri[3 * rep]), rb = s.point(s.tri[3 * rep + 1]), rc = s.point(s.tri[3 * rep + 2]);
+      if (orient3d(ra, rb, rc, pa) == Sign::kZero && orient3d(ra, rb, rc, pb) == Sign::kZero &&
+          orient3d(ra, rb, rc, pc) == Sign::kZero) {
+        plane = p;
+        break;
+      }
+    }
+    if (plane < 0) {
+      plane = geo.add_plane(a, b, c);
+      bucket.emplace_back(plane, t);
+    }
+    tri_plane[t] = plane;
+  }
+  return tri_plane;
+}
+
+}  // namespace
+
+void validate_surface(const SurfaceMesh& s) {
+  const Index np = s.num_points(), nt = s.num_triangles();
+  if (s.tri.size() % 3 != 0 || s.xyz.size() % 3 != 0)
+    throw InputError(ErrorCode::kBadArgument, "input", -1, "arrays must have 3 columns");
+  if (nt == 0) throw InputError(ErrorCode::kBadArgument, "input", -1, "the surface has no triangles");
+  for (Index i = 0; i < np; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(s.xyz[3 * i + k]))
+        throw InputError(ErrorCode::kNonFiniteCoordinate, "input", i,
+                         "vertex " + std::to_string(i) + " has a non-finite coordinate");
+  for (Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (s.tri[3 * t + k] < 0 || s.tri[3 * t + k] >= np)
+        throw InputError(ErrorCode::kBadArgument, "input", t,
+                         "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(s.tri[3 * t + k]) +
+                             ", out of range [0, " + std::to_string(np) + ")");
+  const SurfaceMesh m = merge_coincident_points(s);
+  std::map<std::array<Index, 3>, Index> seen;
+  std::unordered_map<std::uint64_t, std::pair<int, Index>> directed;  // (count, a triangle)
+  for (Index t = 0; t < nt; ++t) {
+    const Index a = m.tri[3 * t], b = m.tri[3 * t + 1], c = m.tri[3 * t + 2];
+    const Vec3 pa = m.point(a), pb = m.point(b), pc = m.point(c);
+    if (a == b || b == c || a == c ||
+        (orient2d_projected(pa, pb, pc, 0) == Sign::kZero && orient2d_projected(pa, pb, pc, 1) == Sign::kZero &&
+         orient2d_projected(pa, pb, pc, 2) == Sign::kZero))
+      throw InputError(ErrorCode::kDegenerateTriangle, "input", t,
+                       tri_str(s, t) + " is degenerate (zero area); remove it or repair the surface");
+    std::array<Index, 3> key = {a, b, c};
+    std::sort(key.begin(), key.end());
+    auto ins = seen.emplace(key, t);
+    if (!ins.second)
+      throw InputError(ErrorCode::kDuplicateTriangle, "input", t,
+                       tri_str(s, t) + " duplicates triangle " + std::to_string(ins.first->second));
+    const Index v[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t e = (static_cast<std::uint64_t>(v[k]) << 32) | static_cast<std::uint32_t>(v[(k + 1) % 3]);
+      auto& d = directed[e];
+      d.first++;
+      d.second = t;
+    }
+  }
+  std::vector<std::uint64_t> keys;
+  keys.reserve(directed.size());
+  for (const auto& kv : directed) keys.push_back(kv.first);
+  std::sort(keys.begin(), keys.end());  // deterministic first error
+  for (std::uint64_t e : keys) {
+    const auto& [count, t] = directed[e];
+    const std::uint64_t rev = (e << 32) | (e >> 32);
+    auto it = directed.find(rev);
+    const int back = it == directed.end() ? 0 : it->second.first;
+    const std::string edge = "(" + std::to_string(e >> 32) + " " + std::to_string(e & 0xffffffffu) + ")";
+    if (back == 0 && count == 1)
+      throw InputError(ErrorCode::kOpenBoundary, "input", t,
+                       "edge " + edge + " of " + tri_str(s, t) +
+                           " is used by only one triangle: the surface is open there (fill the hole)");
+    if (back != count)
+      throw InputError(ErrorCode::kInconsistentOrientation, "input", t,
+                       "edge " + edge + " of " + tri_str(s, t) + " is used " + std::to_string(count) +
+                           " times in one direction and " + std::to_string(back) +
+                           " in the other: the triangles around it are inconsistently oriented or non-manifold");
+  }
+}
+
+TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+  const auto t_start = Clock::now();
+  MeshStats st;
+  auto stage_time = [&](const char* name, Clock::time_point since) {
+    st.seconds_by_stage[name] += std::chrono::duration<double>(Clock::now() - since).count();
+  };
+  auto progress = [&](const std::string& stage, double f) {
+    if (options.progress) options.progress(stage, f);
+  };
+  st.input_points = input.num_points();
+  st.input_triangles = input.num_triangles();
+
+  auto t0 = Clock::now();
+  progress("checking the input", 0);
+  validate_surface(input);
+  const SurfaceMesh surface = merge_coincident_points(input);
+  stage_time("input_check", t0);
+
+  t0 = Clock::now();
+  std::vector<Vec3> pts;
+  pts.reserve(surface.num_points() + 8);
+  for (Index i = 0; i < surface.num_points(); ++i) pts.push_back(surface.point(i));
+  for (const Vec3& c : BspComplex::box_corners(surface)) pts.push_back(c);
+  ImplicitGeometry geo(std::move(pts));
+  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+  std::vector<Index> tri_plane = group_planes(geo, surface);
+  st.input_planes = geo.num_planes();
+  for (Index t = 0; t < surface.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) geo.note_on_plane(surface.tri[3 * t + k], tri_plane[t]);
+  stage_time("planes", t0);
+
+  t0 = Clock::now();
+  BspComplex bsp(geo, surface, std::move(tri_plane));
+  bsp.set_debug_checks(options.debug_checks);
+  if (options.debug_checks) bsp.check_consistency();
+  bsp.build(options.cancelled, [&](double f) { progress("BSP tree", f); });
+  bsp.identify_input_vertices();
+  bsp.refine_covered_faces();
+  bsp.identify_input_vertices();
+  stage_time("bsp", t0);
+
+  t0 = Clock::now();
+  progress("inside / outside", 0);
+  const CellLabels labels = classify_cells(bsp);
+  stage_time("classify", t0);
+
+  t0 = Clock::now();
+  progress("tetrahedralizing cells", 0);
+  std::int64_t inside = 0;
+  const std::vector<std::array<Index, 4>> tets = tetrahedralize_cells(bsp, labels, &inside);
+  stage_time("cell_tets", t0);
+
+  // BSP points on the surface: vertices that are not input points on faces between an inside and
+  // an outside cell.
+  std::vector<char> on_boundary(geo.num_vertices(), 0);
+  for (std::size_t f = 0; f < bsp.faces().size(); ++f) {
+    const BspFace& face = bsp.faces()[f];
+    if (!face.alive || labels.coverage[f] == 0) continue;
+    const int w0 = face.cell[0] >= 0 ? labels.winding[face.cell[0]] : 0;
+    const int w1 = face.cell[1] >= 0 ? labels.winding[face.cell[1]] : 0;
+    if (w0 == w1) continue;
+    for (Index v : face.verts)
+      if (v >= surface.num_points()) on_boundary[v] = 1;
+  }
+  std::int64_t boundary_steiner = 0;
+  {
+    std::vector<char> counted(geo.num_vertices(), 0);
+    for (const auto& t : tets)
+      for (Index v : t)
+        if (on_boundary[v] && !counted[v]) counted[v] = 1, ++boundary_steiner;
+  }
+  if (boundary_steiner > 0 && !options.allow_boundary_steiner)
+    throw MeshingError(ErrorCode::kInternal, "steiner", boundary_steiner,
+                       std::to_string(boundary_steiner) +
+                           " BSP points lie on the input surface and removing them is not implemented yet; "
+                           "allow boundary Steiner points to mesh anyway");
+
+  t0 = Clock::now();
+  progress("rounding", 0);
+  std::int64_t steiner = 0;
+  TetMesh mesh = snap_round(geo, tets, surface.num_points(), &steiner);
+  stage_time("snap_round", t0);
+
+  st.points = mesh.num_points();
+  st.tets = mesh.num_tets();
+  st.steiner_points = steiner;
+  st.boundary_steiner_points = boundary_steiner;
+  st.bsp_nodes = 2 * bsp.stats().splits + 1;
+  st.convex_cells = bsp.stats().leaves;
+  st.inside_cells = inside;
+  st.bsp_points = bsp.stats().bsp_points;
+  st.exact_fallbacks = geo.exact_fallbacks();
+  st.seconds_total = std::chrono::duration<double>(Clock::now() - t_start).count();
+  if (stats) *stats = st;
+  return mesh;
+}
+
+}  // namespace bsptet
