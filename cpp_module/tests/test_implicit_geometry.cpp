@@ -1,0 +1,77 @@
+// A TPI vertex must behave exactly like the explicit point at the same place. Three axis-aligned
+// planes through grid points meet at a grid point; oblique planes through grid points then pass
+// exactly through many of them (exact zeros), which exercises the filter and the exact fallback.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "bsptet/implicit_geometry.h"
+
+using namespace bsptet;
+
+TEST(ImplicitGeometry, TpiVertexMatchesExplicitPoint) {
+  const unsigned seed = 99u;
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> G(-4, 4);
+  int zeros = 0, total = 0;
+  for (int it = 0; it < 300; ++it) {
+    const double s = (it % 3 == 0) ? 0.1 : (it % 3 == 1 ? 1e-7 : 3e5);  // 0.1 is not dyadic
+    const double a = G(rng) * s, b = G(rng) * s, c = G(rng) * s;
+    std::vector<Vec3> pts = {
+        {a, 0, 0}, {a, 1, 0}, {a, 0, 1},   // x = a
+        {0, b, 0}, {0, b, 1}, {1, b, 0},   // y = b
+        {0, 0, c}, {1, 0, c}, {0, 1, c},   // z = c
+        {a, b, c},                          // the same point, explicit
+    };
+    for (int k = 0; k < 9; ++k) pts.push_back({G(rng) * s, G(rng) * s, G(rng) * s});
+    ImplicitGeometry geo(pts);
+    for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+    const Index px = geo.add_plane(0, 1, 2), py = geo.add_plane(3, 4, 5), pz = geo.add_plane(6, 7, 8);
+    const Index tpi = geo.add_tpi_vertex(px, py, pz);
+    const Vec3 r = geo.rounded(tpi);
+    if (s != 0.1) {  // exactly representable: rounding is exact
+      EXPECT_EQ(r.x, a);
+      EXPECT_EQ(r.y, b);
+      EXPECT_EQ(r.z, c);
+    }
+    // Oblique planes through (a, b, c) and two random points, and through three random points.
+    for (int k = 10; k + 1 < 19; ++k) {
+      for (const auto& def : {std::array<Index, 3>{9, k, k + 1}, std::array<Index, 3>{k, k + 1, (k + 2 - 10) % 9 + 10}}) {
+        const Vec3 &p = pts[def[0]], &q = pts[def[1]], &w = pts[def[2]];
+        if (orient2d_projected(p, q, w, 0) == Sign::kZero && orient2d_projected(p, q, w, 1) == Sign::kZero &&
+            orient2d_projected(p, q, w, 2) == Sign::kZero)
+          continue;  // collinear: not a plane
+        const Index pl = geo.add_plane(def[0], def[1], def[2]);
+        const Sign implicit = geo.side(pl, tpi);
+        const Sign explicit_sign = orient3d(p, q, w, pts[9]);
+        ASSERT_EQ(implicit, explicit_sign) << "iteration " << it << " seed " << seed;
+        zeros += implicit == Sign::kZero;
+        ++total;
+      }
+    }
+  }
+  EXPECT_GT(zeros, total / 4) << "the test must exercise exact zeros";
+}
+
+TEST(ImplicitGeometry, Orient2dOfTpiVerticesMatchesExplicit) {
+  // Vertices on the plane z = 0.3 (not dyadic) given as TPIs of x = i, y = j, z = 0.3.
+  std::vector<Vec3> pts = {{0, 0, 0.3}, {1, 0, 0.3}, {0, 1, 0.3}};
+  for (int i = 0; i < 3; ++i) pts.insert(pts.end(), {{double(i), 0, 0}, {double(i), 1, 0}, {double(i), 0, 1}});
+  for (int j = 0; j < 3; ++j) pts.insert(pts.end(), {{0, double(j), 0}, {0, double(j), 1}, {1, double(j), 0}});
+  ImplicitGeometry geo(pts);
+  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+  const Index pz = geo.add_plane(0, 1, 2);
+  Index px[3], py[3];
+  for (int i = 0; i < 3; ++i) px[i] = geo.add_plane(3 + 3 * i, 4 + 3 * i, 5 + 3 * i);
+  for (int j = 0; j < 3; ++j) py[j] = geo.add_plane(12 + 3 * j, 13 + 3 * j, 14 + 3 * j);
+  Index v[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) v[i][j] = geo.add_tpi_vertex(px[i], py[j], pz);
+  EXPECT_EQ(geo.orient2d(v[0][0], v[1][0], v[0][1], 2), Sign::kPositive);
+  EXPECT_EQ(geo.orient2d(v[0][0], v[0][1], v[1][0], 2), Sign::kNegative);
+  EXPECT_EQ(geo.orient2d(v[0][0], v[1][1], v[2][2], 2), Sign::kZero);  // collinear on the diagonal
+  EXPECT_EQ(geo.orient2d(v[0][0], v[1][0], v[2][0], 2), Sign::kZero);
+  EXPECT_EQ(geo.side(pz, v[2][1]), Sign::kZero);
+}
