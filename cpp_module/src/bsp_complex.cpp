@@ -167,6 +167,52 @@ void BspComplex::split_edge(Index u, Index w, Index x) {
   }
 }
 
+std::array<Index, 2> BspComplex::split_face(Index f, Index q, std::map<Index, int>& sign) {
+  // The face is convex and q crosses its interior: exactly two zero vertices bound the runs of
+  // positive and negative vertices. Returns {positive half, negative half}; f dies.
+  const std::vector<Index> v = faces_[f].verts;
+  const std::size_t n = v.size();
+  std::size_t start = n;
+  for (std::size_t i = 0; i < n; ++i)
+    if (sign[v[i]] == 0 && sign[v[(i + 1) % n]] > 0) start = i;
+  if (start == n) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face split without a zero vertex");
+  BspFace h[2];
+  for (auto& hf : h) {
+    hf.plane = faces_[f].plane;
+    hf.cell[0] = faces_[f].cell[0];
+    hf.cell[1] = faces_[f].cell[1];
+  }
+  std::size_t i = start;
+  h[0].verts.push_back(v[i]);
+  i = (i + 1) % n;
+  while (sign[v[i]] > 0) {
+    h[0].verts.push_back(v[i]);
+    i = (i + 1) % n;
+  }
+  if (sign[v[i]] != 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face split: sign run broken");
+  h[0].verts.push_back(v[i]);
+  h[1].verts.push_back(v[i]);
+  i = (i + 1) % n;
+  while (i != start) {
+    if (sign[v[i]] > 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face not convex");
+    h[1].verts.push_back(v[i]);
+    i = (i + 1) % n;
+  }
+  h[1].verts.push_back(v[start]);
+  edge_line_[edge_key(h[0].verts.front(), h[0].verts.back())] = {faces_[f].plane, q};
+  for (Index t : faces_[f].coplanar) {
+    int mn = 0, mx = 0;
+    classify_triangle(t, q, mn, mx);
+    if (mx > 0) h[0].coplanar.push_back(t);
+    if (mn < 0) h[1].coplanar.push_back(t);
+  }
+  unregister_edges(f);
+  faces_[f].alive = false;
+  const Index i0 = new_face(std::move(h[0]));
+  const Index i1 = new_face(std::move(h[1]));
+  return {i0, i1};
+}
+
 bool BspComplex::split_cell(Index c, Index p) {
   // 1. Classify the cell's vertices.
   std::map<Index, int> sign;
@@ -208,51 +254,14 @@ bool BspComplex::split_cell(Index c, Index p) {
       fn = fn || sign[v] < 0;
     }
     if (fp && fn) {
-      const std::vector<Index> v = faces_[f].verts;
-      const std::size_t n = v.size();
-      // Rotate so that we start at the zero vertex followed by a positive run.
-      std::size_t start = n;
-      for (std::size_t i = 0; i < n; ++i)
-        if (sign[v[i]] == 0 && sign[v[(i + 1) % n]] > 0) start = i;
-      if (start == n) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face split without a zero vertex");
-      BspFace fpos, fneg;
-      fpos.plane = fneg.plane = faces_[f].plane;
-      fpos.cell[0] = fneg.cell[0] = faces_[f].cell[0];
-      fpos.cell[1] = fneg.cell[1] = faces_[f].cell[1];
-      std::size_t i = start;
-      fpos.verts.push_back(v[i]);
-      i = (i + 1) % n;
-      while (sign[v[i]] > 0) {
-        fpos.verts.push_back(v[i]);
-        i = (i + 1) % n;
-      }
-      if (sign[v[i]] != 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face split: sign run broken");
-      fpos.verts.push_back(v[i]);
-      fneg.verts.push_back(v[i]);
-      i = (i + 1) % n;
-      while (i != start) {
-        if (sign[v[i]] > 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face not convex");
-        fneg.verts.push_back(v[i]);
-        i = (i + 1) % n;
-      }
-      fneg.verts.push_back(v[start]);
-      edge_line_[edge_key(fpos.verts.front(), fpos.verts.back())] = {faces_[f].plane, p};
-      for (Index t : faces_[f].coplanar) {
-        int mn = 0, mx = 0;
-        classify_triangle(t, p, mn, mx);
-        if (mx > 0) fpos.coplanar.push_back(t);
-        if (mn < 0) fneg.coplanar.push_back(t);
-      }
-      unregister_edges(f);
-      faces_[f].alive = false;
-      const Index ip = new_face(std::move(fpos));
-      const Index in = new_face(std::move(fneg));
+      const auto [ip, in] = split_face(f, p, sign);
       // The neighbour across f gets both halves.
       for (int side = 0; side < 2; ++side) {
         const Index other = faces_[ip].cell[side];
         if (other < 0 || other == c) continue;
         auto& fl = cells_[other].faces;
         auto it = std::find(fl.begin(), fl.end(), f);
+        if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
         *it = ip;
         fl.push_back(in);
       }
@@ -493,44 +502,7 @@ void BspComplex::refine_covered_faces() {
         split_edge(a, b, x);
       }
     }
-    const std::vector<Index> v = faces_[f].verts;
-    const std::size_t n = v.size();
-    std::size_t start = n;
-    for (std::size_t i = 0; i < n; ++i)
-      if (sign[v[i]] == 0 && sign[v[(i + 1) % n]] > 0) start = i;
-    if (start == n) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face refinement without a zero vertex");
-    BspFace h[2];
-    for (auto& hf : h) {
-      hf.plane = faces_[f].plane;
-      hf.cell[0] = faces_[f].cell[0];
-      hf.cell[1] = faces_[f].cell[1];
-    }
-    std::size_t i = start;
-    h[0].verts.push_back(v[i]);
-    i = (i + 1) % n;
-    while (sign[v[i]] > 0) {
-      h[0].verts.push_back(v[i]);
-      i = (i + 1) % n;
-    }
-    h[0].verts.push_back(v[i]);
-    h[1].verts.push_back(v[i]);
-    i = (i + 1) % n;
-    while (i != start) {
-      h[1].verts.push_back(v[i]);
-      i = (i + 1) % n;
-    }
-    h[1].verts.push_back(v[start]);
-    edge_line_[edge_key(h[0].verts.front(), h[0].verts.back())] = {faces_[f].plane, q};
-    for (Index t : faces_[f].coplanar) {
-      int mn = 0, mx = 0;
-      classify_triangle(t, q, mn, mx);
-      if (mx > 0) h[0].coplanar.push_back(t);
-      if (mn < 0) h[1].coplanar.push_back(t);
-    }
-    unregister_edges(f);
-    faces_[f].alive = false;
-    const Index i0 = new_face(std::move(h[0]));
-    const Index i1 = new_face(std::move(h[1]));
+    const auto [i0, i1] = split_face(f, q, sign);
     for (int side = 0; side < 2; ++side) {
       const Index c = faces_[i0].cell[side];
       if (c < 0) continue;

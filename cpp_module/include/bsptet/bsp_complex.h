@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <unordered_map>
 #include <vector>
 
@@ -97,6 +98,8 @@ class BspComplex {
   Index choose_plane(Index c);
   /// Splits cell c by plane p; returns false when p does not cut c's interior.
   bool split_cell(Index c, Index p);
+  /// Splits face f by plane q (`sign`: side of each of f's vertices, crossing edges already cut).
+  std::array<Index, 2> split_face(Index f, Index q, std::map<Index, int>& sign);
   void split_edge(Index u, Index w, Index x);
   /// The two distinct planes whose intersection is the line of edge (u, w).
   std::array<Index, 2> edge_line(Index u, Index w) const;
