@@ -59,6 +59,22 @@ std::vector<std::array<Index, 4>> tetrahedralize_cells(BspComplex& bsp, const Ce
       for (Index v : faces[f].verts) cv.push_back(v);
     std::sort(cv.begin(), cv.end());
     cv.erase(std::unique(cv.begin(), cv.end()), cv.end());
+    if (cv.size() == 4) {
+      // The cell is a tetrahedron (a convex cell with four vertices has four triangular faces and
+      // no collinear vertex): output it as is, oriented by one of its faces.
+      const BspFace& face = faces[cells[c].faces[0]];
+      Index d = -1;
+      for (Index v : cv)
+        if (std::find(face.verts.begin(), face.verts.end(), v) == face.verts.end()) d = v;
+      const auto& t = face.verts;
+      if (face.cell[0] == static_cast<Index>(c))
+        tets.push_back({t[0], t[1], t[2], d});
+      else
+        tets.push_back({t[0], t[2], t[1], d});
+      for (Index f : cells[c].faces)
+        if (!done[f]) face_tris[f] = {{faces[f].verts[0], faces[f].verts[1], faces[f].verts[2]}}, done[f] = 1;
+      continue;
+    }
     std::vector<Vec3> approx;
     Vec3 centroid{0, 0, 0};
     for (Index v : cv) {

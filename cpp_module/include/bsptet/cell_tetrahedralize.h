@@ -8,7 +8,8 @@
 // T-junction. Then each inside cell is coned from an explicit point strictly inside it (checked
 // exactly) to every face triangle: valid for any convex cell. (Coning from a cell vertex would fan
 // the faces at that vertex from it, disagreeing with the neighbour's triangulation of those faces
-// and skipping collinear vertices.) These interior Steiner points are removed later where possible.
+// and skipping collinear vertices.) A cell that is already a tetrahedron is output as is. The
+// interior Steiner points are to be removed later where possible.
 #pragma once
 
 #include <array>
