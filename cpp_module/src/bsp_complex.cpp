@@ -167,6 +167,20 @@ void BspComplex::split_edge(Index u, Index w, Index x) {
   }
 }
 
+void BspComplex::cut_crossing_edges(Index f, Index q, std::map<Index, int>& sign) {
+  for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
+    const auto& v = faces_[f].verts;
+    const Index a = v[i], b = v[(i + 1) % v.size()];
+    if (sign[a] * sign[b] < 0) {
+      const std::array<Index, 2> line = edge_line(a, b);
+      const Index x = geo_.add_tpi_vertex(line[0], line[1], q);
+      ++stats_.bsp_points;
+      sign[x] = 0;
+      split_edge(a, b, x);  // for every face using the edge: conformity
+    }
+  }
+}
+
 std::array<Index, 2> BspComplex::split_face(Index f, Index q, std::map<Index, int>& sign) {
   // The face is convex and q crosses its interior: exactly two zero vertices bound the runs of
   // positive and negative vertices. Returns {positive half, negative half}; f dies.
@@ -229,17 +243,7 @@ bool BspComplex::split_cell(Index c, Index p) {
   // 2. Cut the crossing edges (for every face that uses them: conformity).
   for (std::size_t fi = 0; fi < cells_[c].faces.size(); ++fi) {
     const Index f = cells_[c].faces[fi];
-    for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
-      const auto& v = faces_[f].verts;
-      const Index a = v[i], b = v[(i + 1) % v.size()];
-      if (sign[a] * sign[b] < 0) {
-        const std::array<Index, 2> line = edge_line(a, b);
-        const Index x = geo_.add_tpi_vertex(line[0], line[1], p);
-        ++stats_.bsp_points;
-        sign[x] = 0;
-        split_edge(a, b, x);
-      }
-    }
+    cut_crossing_edges(f, p, sign);
   }
 
   // 3. Split the crossing faces, for both of their cells.
@@ -363,14 +367,14 @@ void BspComplex::build(const std::function<bool()>& cancelled, const std::functi
   }
 }
 
-void BspComplex::identify_input_vertices() {
+void BspComplex::identify_input_vertices(Index first) {
   std::map<std::array<double, 3>, Index> input_at;
   for (Index i = 0; i < surface_.num_points(); ++i) {
     const Vec3 p = surface_.point(i);
     input_at.emplace(std::array<double, 3>{p.x + 0.0, p.y + 0.0, p.z + 0.0}, i);
   }
   std::unordered_map<Index, Index> replace;
-  for (Index v = corner0_ + 8; v < geo_.num_vertices(); ++v) {
+  for (Index v = std::max(first, corner0_ + 8); v < geo_.num_vertices(); ++v) {
     if (geo_.is_explicit(v)) continue;
     const Vec3 r = geo_.rounded(v);
     auto it = input_at.find({r.x + 0.0, r.y + 0.0, r.z + 0.0});
@@ -491,17 +495,7 @@ void BspComplex::refine_covered_faces() {
     const Index q = edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane);
     std::map<Index, int> sign;
     for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
-    for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
-      const auto& v = faces_[f].verts;
-      const Index a = v[i], b = v[(i + 1) % v.size()];
-      if (sign[a] * sign[b] < 0) {
-        const std::array<Index, 2> line = edge_line(a, b);
-        const Index x = geo_.add_tpi_vertex(line[0], line[1], q);
-        ++stats_.bsp_points;
-        sign[x] = 0;
-        split_edge(a, b, x);
-      }
-    }
+    cut_crossing_edges(f, q, sign);
     const auto [i0, i1] = split_face(f, q, sign);
     for (int side = 0; side < 2; ++side) {
       const Index c = faces_[i0].cell[side];

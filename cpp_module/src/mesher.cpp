@@ -87,7 +87,11 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
 
 }  // namespace
 
-void validate_surface(const SurfaceMesh& s) {
+namespace {
+
+// validate_surface, returning the surface with coincident points merged (so callers need not
+// merge again).
+SurfaceMesh validated_surface(const SurfaceMesh& s) {
   const Index np = s.num_points(), nt = s.num_triangles();
   if (s.tri.size() % 3 != 0 || s.xyz.size() % 3 != 0)
     throw InputError(ErrorCode::kBadArgument, "input", -1, "arrays must have 3 columns");
@@ -148,7 +152,12 @@ void validate_surface(const SurfaceMesh& s) {
                            " times in one direction and " + std::to_string(back) +
                            " in the other: the triangles around it are inconsistently oriented or non-manifold");
   }
+  return m;
 }
+
+}  // namespace
+
+void validate_surface(const SurfaceMesh& s) { validated_surface(s); }
 
 TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
   const auto t_start = Clock::now();
@@ -164,8 +173,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
 
   auto t0 = Clock::now();
   progress("checking the input", 0);
-  validate_surface(input);
-  const SurfaceMesh surface = merge_coincident_points(input);
+  const SurfaceMesh surface = validated_surface(input);
   stage_time("input_check", t0);
 
   t0 = Clock::now();
@@ -187,8 +195,9 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   if (options.debug_checks) bsp.check_consistency();
   bsp.build(options.cancelled, [&](double f) { progress("BSP tree", f); });
   bsp.identify_input_vertices();
+  const Index before_refinement = geo.num_vertices();
   bsp.refine_covered_faces();
-  bsp.identify_input_vertices();
+  bsp.identify_input_vertices(before_refinement);
   stage_time("bsp", t0);
 
   t0 = Clock::now();

@@ -66,7 +66,8 @@ class BspComplex {
   /// point's vertex (splits through input vertices create them: the input vertices are not
   /// vertices of the complex until then). Exact: a rounded-coordinate lookup proposes, the three
   /// defining planes confirm.
-  void identify_input_vertices();
+  /// Only vertices with ids >= `first` are looked at (those created since an earlier call).
+  void identify_input_vertices(Index first = 0);
 
   /// After build(): splits every face that lies on an input plane until each one is inside a single
   /// input triangle (or overlaps none). The covering triangle is then face.coplanar[0]. Splits run
@@ -98,6 +99,9 @@ class BspComplex {
   Index choose_plane(Index c);
   /// Splits cell c by plane p; returns false when p does not cut c's interior.
   bool split_cell(Index c, Index p);
+  /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),
+  /// inserting the new vertex into every face that uses the edge.
+  void cut_crossing_edges(Index f, Index q, std::map<Index, int>& sign);
   /// Splits face f by plane q (`sign`: side of each of f's vertices, crossing edges already cut).
   std::array<Index, 2> split_face(Index f, Index q, std::map<Index, int>& sign);
   void split_edge(Index u, Index w, Index x);
