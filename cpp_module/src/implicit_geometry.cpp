@@ -50,6 +50,15 @@ T det3_homog(const std::array<T, 4>& p, const std::array<T, 4>& q, const std::ar
          p[3] * (q[u] * r[v] - q[v] * r[u]);
 }
 
+// 4x4 determinant of homogeneous rows, by 2x2 minors of rows (0, 1) and (2, 3).
+template <class T>
+T det4_homog(const std::array<T, 4>& r0, const std::array<T, 4>& r1, const std::array<T, 4>& r2,
+             const std::array<T, 4>& r3) {
+  auto m = [](const std::array<T, 4>& p, const std::array<T, 4>& q, int i, int j) { return p[i] * q[j] - p[j] * q[i]; };
+  return m(r0, r1, 0, 1) * m(r2, r3, 2, 3) - m(r0, r1, 0, 2) * m(r2, r3, 1, 3) + m(r0, r1, 0, 3) * m(r2, r3, 1, 2) +
+         m(r0, r1, 1, 2) * m(r2, r3, 0, 3) - m(r0, r1, 1, 3) * m(r2, r3, 0, 2) + m(r0, r1, 2, 3) * m(r2, r3, 0, 1);
+}
+
 Sign to_sign(int s) { return s > 0 ? Sign::kPositive : (s < 0 ? Sign::kNegative : Sign::kZero); }
 
 }  // namespace
@@ -158,7 +167,7 @@ Sign ImplicitGeometry::side(Index p, Index v) {
   const PlaneDef& pd = planes_[p];
   if (vx.explicit_id >= 0) {
     if (vx.explicit_id == pd.a || vx.explicit_id == pd.b || vx.explicit_id == pd.c) return Sign::kZero;
-    return orient3d(points_[pd.a], points_[pd.b], points_[pd.c], points_[vx.explicit_id]);
+    return ::bsptet::orient3d(points_[pd.a], points_[pd.b], points_[pd.c], points_[vx.explicit_id]);
   }
   prepare_plane(p);
   const PlaneCache& c = plane_cache_[p];
@@ -173,6 +182,23 @@ Sign ImplicitGeometry::side(Index p, Index v) {
   const int se = side_value<ExactFloat>(e.data(), he).sign() * he[3].sign();
   if (se == 0) note_on_plane(v, p);
   return to_sign(se);
+}
+
+Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
+  const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
+  if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)
+    return ::bsptet::orient3d(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
+                            points_[vd.explicit_id]);
+  // det[[a 1]; [b 1]; [c 1]; [d 1]] = -det[b - a, c - a, d - a]; homogeneous rows scale it by the
+  // product of the weights.
+  const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c), &hd = vertex_interval(d);
+  const int s = det4_homog<Interval>(ha, hb, hc, hd).certain_sign();
+  const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign() * hd[3].certain_sign();
+  if (s != 0 && w != 0) return to_sign(-s * w);
+  ++exact_fallbacks_;
+  const auto &ea = vertex_exact(a), &eb = vertex_exact(b), &ec = vertex_exact(c), &ed = vertex_exact(d);
+  return to_sign(-det4_homog<ExactFloat>(ea, eb, ec, ed).sign() * ea[3].sign() * eb[3].sign() * ec[3].sign() *
+                 ed[3].sign());
 }
 
 Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {

@@ -20,6 +20,7 @@
 #include "bsptet/implicit_geometry.h"
 #include "bsptet/predicates.h"
 #include "bsptet/snap_round.h"
+#include "bsptet/steiner_removal.h"
 
 namespace bsptet {
 
@@ -190,6 +191,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   stage_time("planes", t0);
 
   t0 = Clock::now();
+  const std::vector<Index> tri_plane_copy = tri_plane;
   BspComplex bsp(geo, surface, std::move(tri_plane));
   bsp.set_debug_checks(options.debug_checks);
   if (options.debug_checks) bsp.check_consistency();
@@ -207,34 +209,18 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
 
   t0 = Clock::now();
   progress("tetrahedralizing cells", 0);
-  std::int64_t inside = 0;
-  const std::vector<std::array<Index, 4>> tets = tetrahedralize_cells(bsp, labels, &inside);
+  const CellTets cell_tets = tetrahedralize_cells(bsp, labels);
   stage_time("cell_tets", t0);
 
-  // BSP points on the surface: vertices that are not input points on faces between an inside and
-  // an outside cell.
-  std::vector<char> on_boundary(geo.num_vertices(), 0);
-  for (std::size_t f = 0; f < bsp.faces().size(); ++f) {
-    const BspFace& face = bsp.faces()[f];
-    if (!face.alive || labels.coverage[f] == 0) continue;
-    const int w0 = face.cell[0] >= 0 ? labels.winding[face.cell[0]] : 0;
-    const int w1 = face.cell[1] >= 0 ? labels.winding[face.cell[1]] : 0;
-    if (w0 == w1) continue;
-    for (Index v : face.verts)
-      if (v >= surface.num_points()) on_boundary[v] = 1;
-  }
-  std::int64_t boundary_steiner = 0;
-  {
-    std::vector<char> counted(geo.num_vertices(), 0);
-    for (const auto& t : tets)
-      for (Index v : t)
-        if (on_boundary[v] && !counted[v]) counted[v] = 1, ++boundary_steiner;
-  }
-  if (boundary_steiner > 0 && !options.allow_boundary_steiner)
-    throw MeshingError(ErrorCode::kInternal, "steiner", boundary_steiner,
-                       std::to_string(boundary_steiner) +
-                           " BSP points lie on the input surface and removing them is not implemented yet; "
-                           "allow boundary Steiner points to mesh anyway");
+  t0 = Clock::now();
+  SteinerRemovalOptions so;
+  so.allow_boundary_steiner = options.allow_boundary_steiner;
+  so.cancelled = options.cancelled;
+  so.progress = [&](double f) { progress("removing Steiner points", f); };
+  SteinerRemovalStats ss;
+  const std::vector<std::array<Index, 4>> tets =
+      remove_steiner_points(geo, surface, tri_plane_copy, cell_tets, so, &ss);
+  stage_time("steiner_removal", t0);
 
   t0 = Clock::now();
   progress("rounding", 0);
@@ -245,10 +231,16 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   st.points = mesh.num_points();
   st.tets = mesh.num_tets();
   st.steiner_points = steiner;
-  st.boundary_steiner_points = boundary_steiner;
+  st.boundary_steiner_points = ss.boundary_steiner_after;
+  st.steiner_before_removal = ss.steiner_before;
+  st.boundary_steiner_before_removal = ss.boundary_steiner_before;
+  st.collapsed = ss.collapsed;
+  st.relocated = ss.relocated;
+  st.apex_cells = cell_tets.apex_cells;
+  st.pulled_cells = cell_tets.pulled_cells;
   st.bsp_nodes = 2 * bsp.stats().splits + 1;
   st.convex_cells = bsp.stats().leaves;
-  st.inside_cells = inside;
+  st.inside_cells = cell_tets.inside_cells;
   st.bsp_points = bsp.stats().bsp_points;
   st.exact_fallbacks = geo.exact_fallbacks();
   st.seconds_total = std::chrono::duration<double>(Clock::now() - t_start).count();

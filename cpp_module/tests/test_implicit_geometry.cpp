@@ -75,3 +75,46 @@ TEST(ImplicitGeometry, Orient2dOfTpiVerticesMatchesExplicit) {
   EXPECT_EQ(geo.orient2d(v[0][0], v[1][0], v[2][0], 2), Sign::kZero);
   EXPECT_EQ(geo.side(pz, v[2][1]), Sign::kZero);
 }
+
+TEST(ImplicitGeometry, Orient3dWithTpiVerticesMatchesExplicit) {
+  // TPI vertices of axis planes through grid points (x = i, y = j, z = k * 0.1): orient3d of any
+  // four of them, implicit or explicit, must agree, including the many exact zeros of a grid.
+  const unsigned seed = 7u;
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 3; ++i) pts.insert(pts.end(), {{i * 0.1, 0, 0}, {i * 0.1, 1, 0}, {i * 0.1, 0, 1}});
+  for (int j = 0; j < 3; ++j) pts.insert(pts.end(), {{0, j * 0.1, 0}, {0, j * 0.1, 1}, {1, j * 0.1, 0}});
+  for (int k = 0; k < 3; ++k) pts.insert(pts.end(), {{0, 0, k * 0.1}, {1, 0, k * 0.1}, {0, 1, k * 0.1}});
+  const std::size_t first_grid = pts.size();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) pts.push_back({i * 0.1, j * 0.1, k * 0.1});
+  ImplicitGeometry geo(pts);
+  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+  Index pl[3][3];
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < 3; ++i) pl[a][i] = geo.add_plane(9 * a + 3 * i, 9 * a + 3 * i + 1, 9 * a + 3 * i + 2);
+  std::vector<Index> tpi(27), expl(27);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) {
+        tpi[9 * i + 3 * j + k] = geo.add_tpi_vertex(pl[0][i], pl[1][j], pl[2][k]);
+        expl[9 * i + 3 * j + k] = static_cast<Index>(first_grid) + 9 * i + 3 * j + k;
+      }
+  std::uniform_int_distribution<int> G(0, 26), B(0, 1);
+  int zeros = 0;
+  for (int it = 0; it < 2000; ++it) {
+    const int q[4] = {G(rng), G(rng), G(rng), G(rng)};
+    Index v[4];
+    for (int m = 0; m < 4; ++m) v[m] = B(rng) ? tpi[q[m]] : expl[q[m]];
+    // The explicit grid points are the rounded values of 0.1 multiples, the TPIs the same planes'
+    // exact intersections: both are the same points, as the planes pass through the grid doubles.
+    const Sign want = orient3d(pts[first_grid + q[0]], pts[first_grid + q[1]], pts[first_grid + q[2]],
+                               pts[first_grid + q[3]]);
+    ASSERT_EQ(geo.orient3d(v[0], v[1], v[2], v[3]), want) << "iteration " << it;
+    zeros += want == Sign::kZero;
+  }
+  EXPECT_GT(zeros, 100);
+  EXPECT_LT(zeros, 1900);
+}

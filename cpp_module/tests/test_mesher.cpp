@@ -18,49 +18,58 @@ std::string data(const std::string& rel) { return std::string(FEMBSPTET_DATA_DIR
 
 }  // namespace
 
-class PaperPolyhedron : public ::testing::TestWithParam<const char*> {};
+struct PaperCase {
+  const char* name;
+  int paper_steiner, paper_tets;    // Joshi & Ourselin, Table 1
+  int tetgen_steiner, tetgen_tets;  // tetgen 1.5 -pY on the same surface
+};
 
-// Work in progress (issue 3): BSP points that land on the input surface are not removed yet, and
-// rounding them to doubles moves them off their input triangles. So today:
-//  * the default (no boundary Steiner points) refuses with a clear error when any remain;
-//  * with boundary Steiner points allowed, the mesh is checked: its tets must all be positive, its
-//    faces paired and its boundary closed; the only defects allowed are boundary faces that left
-//    the surface through rounded boundary Steiner points, and a mesh whose BSP points round
-//    exactly (dented_box) must be fully valid.
-TEST_P(PaperPolyhedron, MeshIsValidUpToRoundedBoundarySteinerPoints) {
-  const SurfaceMesh s = read_off(data(std::string("paper/") + GetParam() + ".off"));
+class PaperPolyhedron : public ::testing::TestWithParam<PaperCase> {};
+
+// The default output must be fully valid (exact checker), with no Steiner point on the surface.
+// Steiner counts are printed beside the paper's and TetGen's. The bound asserted is the one we meet
+// today (issue 3 asks for no more than TetGen's; see docs/core-design.md for where we stand).
+TEST_P(PaperPolyhedron, DefaultMeshIsValidWithNoSurfaceSteinerPoint) {
+  const PaperCase c = GetParam();
+  const SurfaceMesh s = read_off(data(std::string("paper/") + c.name + ".off"));
   MeshOptions o;
-  o.allow_boundary_steiner = true;
   o.debug_checks = true;
   MeshStats st;
   const TetMesh m = tetrahedralize(s, o, &st);
-  std::printf("%s: %lld tets, %lld Steiner (%lld on the boundary), %lld BSP nodes, %lld cells\n", GetParam(),
-              (long long)st.tets, (long long)st.steiner_points, (long long)st.boundary_steiner_points,
-              (long long)st.bsp_nodes, (long long)st.convex_cells);
+  std::printf("%-14s ours %2lld Steiner / %3lld tets | paper %d/%d | tetgen -pY %d/%d\n", c.name,
+              (long long)st.steiner_points, (long long)st.tets, c.paper_steiner, c.paper_tets, c.tetgen_steiner,
+              c.tetgen_tets);
   const MeshCheckReport r = check_mesh(s, m);
-  EXPECT_EQ(r.inverted_tets + r.flat_tets, 0);
-  EXPECT_EQ(r.overshared_faces + r.same_orientation_faces, 0);
-  EXPECT_EQ(r.unpaired_boundary_edges, 0);
-  EXPECT_EQ(r.duplicate_points + r.unreferenced_points + r.boundary_faces_inward, 0);
-  EXPECT_NEAR(r.tet_volume, r.surface_volume, 1e-12 * std::fabs(r.surface_volume));
-  if (std::string(GetParam()) == "dented_box") {
-    EXPECT_TRUE(r.valid);
-    for (const auto& msg : r.messages) ADD_FAILURE() << msg;
-  }
-  if (!r.valid) EXPECT_GT(st.boundary_steiner_points, 0) << "invalid without boundary Steiner points";
-  // The default refuses rather than output BSP points on the surface.
-  if (st.boundary_steiner_points > 0) {
-    try {
-      tetrahedralize(s);
-      ADD_FAILURE() << "boundary Steiner points were output by default";
-    } catch (const MeshingError& e) {
-      EXPECT_NE(std::string(e.what()).find("not implemented yet"), std::string::npos) << e.what();
-    }
-  }
+  EXPECT_TRUE(r.valid);
+  for (const auto& msg : r.messages) ADD_FAILURE() << msg;
+  EXPECT_EQ(r.boundary_steiner_points, 0);
+  EXPECT_EQ(st.boundary_steiner_points, 0);
+  EXPECT_EQ(r.steiner_points, st.steiner_points);
+  EXPECT_EQ(r.tets, st.tets);
+  // Deterministic: the same input gives the same mesh.
+  const TetMesh again = tetrahedralize(s, o);
+  EXPECT_EQ(again.xyz, m.xyz);
+  EXPECT_EQ(again.tet, m.tet);
+}
+
+TEST_P(PaperPolyhedron, BoundarySteinerPointsAllowedStillValid) {
+  const PaperCase c = GetParam();
+  const SurfaceMesh s = read_off(data(std::string("paper/") + c.name + ".off"));
+  MeshOptions o;
+  o.allow_boundary_steiner = true;
+  MeshStats st;
+  const TetMesh m = tetrahedralize(s, o, &st);
+  const MeshCheckReport r = check_mesh(s, m);
+  EXPECT_TRUE(r.valid);
+  for (const auto& msg : r.messages) ADD_FAILURE() << msg;
+  EXPECT_EQ(r.boundary_steiner_points, st.boundary_steiner_points);
 }
 
 INSTANTIATE_TEST_SUITE_P(Paper, PaperPolyhedron,
-                         ::testing::Values("dented_box", "schoenhardt", "box_with_hole", "dented_prism"));
+                         ::testing::Values(PaperCase{"dented_box", 0, 9, 0, 6}, PaperCase{"schoenhardt", 6, 18, 1, 8},
+                                           PaperCase{"box_with_hole", 1, 29, 0, 24},
+                                           PaperCase{"dented_prism", 7, 70, 1, 41}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 TEST(Mesher, RejectsOpenSurface) {
   SurfaceMesh s = read_off(data("paper/dented_box.off"));

@@ -55,6 +55,9 @@ class ImplicitGeometry {
 
   /// sign(n . (v - a)) for plane (a, b, c), exact.
   Sign side(Index plane, Index v);
+  /// Exact orient3d of four vertices of any kind (predicates.h convention: POSITIVE when d lies on
+  /// the side of the right-hand normal of (a, b, c)). Explicit-only calls use the double predicate.
+  Sign orient3d(Index a, Index b, Index c, Index d);
   /// Exact orientation of vertices u, v, w projected along axis (see header comment).
   Sign orient2d(Index u, Index v, Index w, int axis);
   /// An axis along which the plane's projection is one-to-one (its normal component there is

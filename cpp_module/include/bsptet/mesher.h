@@ -10,6 +10,7 @@
 //   2.2      inside / outside .................. cell_classify.cpp (exact coverage + winding numbers)
 //   2.3      per-cell tetrahedralization ....... cell_tetrahedralize.cpp
 //   2.4/2.5  glue, crossed-edge fixing ......... not needed: the complex is conforming (bsp_complex.h)
+//   (new)    Steiner point removal ............. steiner_removal.cpp (collapse, move off the surface)
 //   output   doubles, checked exactly .......... snap_round.cpp
 #pragma once
 
@@ -23,9 +24,8 @@
 namespace bsptet {
 
 struct MeshOptions {
-  /// Keep BSP points that lie on the input surface. The default output must have none (FEM loads
-  /// find nodes on CAD faces); until their removal is built, meshing with this false fails with a
-  /// clear error when such points remain.
+  /// Keep BSP points on the input surface where they are exactly doubles. The default output has
+  /// none (FEM loads find nodes on CAD faces): they are collapsed or moved inside.
   bool allow_boundary_steiner = false;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;
@@ -39,6 +39,8 @@ struct MeshStats {
   std::int64_t input_points = 0, input_triangles = 0, input_planes = 0;
   std::int64_t points = 0, tets = 0, steiner_points = 0, boundary_steiner_points = 0;
   std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
+  std::int64_t steiner_before_removal = 0, boundary_steiner_before_removal = 0, collapsed = 0, relocated = 0;
+  std::int64_t apex_cells = 0, pulled_cells = 0;
   std::int64_t exact_fallbacks = 0;
   std::map<std::string, double> seconds_by_stage;
   double seconds_total = 0;
