@@ -5,7 +5,7 @@
     fembsptet check SURFACE TETMESH [--json]
 
 Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
-mesh is not valid; 1 internal failure (or a feature that is not built yet); 130 interrupted.
+mesh is not valid; 1 internal failure; 130 interrupted.
 Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli``.
 """
 
@@ -33,6 +33,7 @@ STATS_KEYS = (
     "tets",
     "steiner_points",
     "boundary_steiner_points",
+    "interior_steiner_points",
     "bsp_nodes",
     "convex_cells",
     "min_dihedral_deg",
@@ -122,21 +123,28 @@ def _cmd_mesh(args):
 
     progress("tetrahedralizing")
     try:
-        result = core.tetrahedralize(surfaces, options={"size": args.size, "order": args.order},
-                                     progress=progress)
+        mesh, stats = core.tetrahedralize(
+            surfaces,
+            options={"size": args.size if _ext(args.input) in SURFACE_EXTENSIONS else None,
+                     "order": args.order,
+                     "allow_boundary_steiner": args.allow_boundary_steiner},
+            progress=progress)
     finally:
         progress.finish()
-    # Not reached until the core lands: core.tetrahedralize raises NotImplementedYetError.
-    mesh, stats = result
+    progress("writing")
     for out in args.output:
         write_output(out, mesh)
+    progress.finish()
     stats["seconds_total"] = time.perf_counter() - t0
+    for note in stats.get("notes", []):
+        print(f"fembsptet: note: {note}", file=sys.stderr)
     if args.stats_json:
         from .atomic_file import atomic_output
 
         with atomic_output(args.stats_json) as f:
             json.dump(stats, f, indent=1)
-    print(json.dumps({k: stats.get(k) for k in STATS_KEYS}, indent=1))
+    if not args.quiet:
+        print(json.dumps({k: stats.get(k) for k in STATS_KEYS}, indent=1))
     if args.compare_tetgen:
         print(_tetgen_table(surfaces, stats))
     return 0
@@ -245,7 +253,10 @@ def build_parser():
     m.add_argument("--size", type=float, default=None, help="maximum element size (edge length)")
     m.add_argument("--order", type=int, choices=(1, 2), default=1, help="element order")
     m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
-    m.add_argument("--quiet", action="store_true", help="no progress bar")
+    m.add_argument("--quiet", action="store_true", help="no progress bar and no statistics on stdout")
+    m.add_argument("--allow-boundary-steiner", action="store_true",
+                   help="keep Steiner points on the surface where they are exactly doubles "
+                        "(default: none on the surface, as tetgen -Y)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.set_defaults(func=_cmd_mesh)

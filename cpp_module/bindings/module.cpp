@@ -8,6 +8,7 @@
 
 #include "bsptet/errors.h"
 #include "bsptet/mesh_check.h"
+#include "bsptet/mesher.h"
 #include "bsptet/predicates.h"
 
 namespace py = pybind11;
@@ -66,6 +67,94 @@ TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
 PYBIND11_MODULE(_bsptet, m) {
   m.doc() = "FemBspTet C++ core (private; use FemBspTet.core)";
   m.attr("__version__") = FEMBSPTET_VERSION;
+
+  // Core errors reach Python as these types; FemBspTet.core turns them into FemBspTet.errors.
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<MeshingError> meshing_error(m, "MeshingError", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
+      exc.attr("code") = error_code_name(e.code());
+      exc.attr("index") = e.index();
+      PyErr_SetObject(input_error.ptr(), exc.ptr());
+    } catch (const MeshingError& e) {
+      py::object exc = py::reinterpret_borrow<py::object>(meshing_error.ptr())(e.what());
+      exc.attr("code") = error_code_name(e.code());
+      exc.attr("index") = e.index();
+      PyErr_SetObject(meshing_error.ptr(), exc.ptr());
+    }
+  });
+
+  m.def(
+      "tetrahedralize",
+      [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
+         py::object cancel) {
+        SurfaceMesh s;
+        s.xyz = points_from(points, "points");
+        s.tri = indices_from(triangles, "triangles", 3);
+        MeshOptions o;
+        o.allow_boundary_steiner = allow_boundary_steiner;
+        bool interrupted = false;
+        // Callbacks run without the GIL held by the core: take it for each call. Ctrl-C (a pending
+        // SIGINT) cancels the run; so does `cancel()` returning True.
+        o.cancelled = [&]() {
+          py::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) {
+            PyErr_Clear();
+            interrupted = true;
+            return true;
+          }
+          return !cancel.is_none() && cancel().cast<bool>();
+        };
+        if (!progress.is_none())
+          o.progress = [&](const std::string& stage, double f) {
+            py::gil_scoped_acquire gil;
+            progress(stage, f);
+          };
+        TetMesh mesh;
+        MeshStats st;
+        try {
+          py::gil_scoped_release release;
+          mesh = tetrahedralize(s, o, &st);
+        } catch (const MeshingError& e) {
+          if (e.code() == ErrorCode::kCancelled && interrupted) {
+            PyErr_SetNone(PyExc_KeyboardInterrupt);
+            throw py::error_already_set();
+          }
+          throw;
+        }
+        py::array_t<double> xyz({static_cast<py::ssize_t>(mesh.num_points()), static_cast<py::ssize_t>(3)});
+        std::copy(mesh.xyz.begin(), mesh.xyz.end(), xyz.mutable_data());
+        py::array_t<std::int64_t> tets({static_cast<py::ssize_t>(mesh.num_tets()), static_cast<py::ssize_t>(4)});
+        std::copy(mesh.tet.begin(), mesh.tet.end(), tets.mutable_data());
+        py::dict d;
+        d["input_points"] = st.input_points;
+        d["input_triangles"] = st.input_triangles;
+        d["input_planes"] = st.input_planes;
+        d["points"] = st.points;
+        d["tets"] = st.tets;
+        d["steiner_points"] = st.steiner_points;
+        d["boundary_steiner_points"] = st.boundary_steiner_points;
+        d["interior_steiner_points"] = st.steiner_points - st.boundary_steiner_points;
+        d["bsp_nodes"] = st.bsp_nodes;
+        d["convex_cells"] = st.convex_cells;
+        d["inside_cells"] = st.inside_cells;
+        d["bsp_points"] = st.bsp_points;
+        d["steiner_points_before_removal"] = st.steiner_before_removal;
+        d["surface_steiner_points_before_removal"] = st.boundary_steiner_before_removal;
+        d["collapsed"] = st.collapsed;
+        d["relocated"] = st.relocated;
+        d["exact_fallbacks"] = st.exact_fallbacks;
+        d["seconds_by_stage"] = st.seconds_by_stage;
+        d["seconds_core"] = st.seconds_total;
+        return py::make_tuple(xyz, tets, d);
+      },
+      py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
+      "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError.");
 
   m.def(
       "orient3d",

@@ -94,6 +94,33 @@ Index ImplicitGeometry::add_tpi_vertex(Index p, Index q, Index r) {
   return static_cast<Index>(verts_.size() - 1);
 }
 
+Index ImplicitGeometry::add_centroid_vertex(const std::array<Index, 4>& of) {
+  Vertex v;
+  v.centroid_of = of;
+  verts_.push_back(std::move(v));
+  return static_cast<Index>(verts_.size() - 1);
+}
+
+namespace {
+// Homogeneous centroid of four homogeneous points: (sum_i X_i prod_{j != i} W_j, 4 prod_j W_j).
+template <class T>
+std::array<T, 4> centroid4(const std::array<const std::array<T, 4>*, 4>& h) {
+  std::array<T, 4> out;
+  for (int k = 0; k < 3; ++k) {
+    T sum = T(0.0);
+    for (int i = 0; i < 4; ++i) {
+      T term = (*h[i])[k];
+      for (int j = 0; j < 4; ++j)
+        if (j != i) term = term * (*h[j])[3];
+      sum = sum + term;
+    }
+    out[k] = sum;
+  }
+  out[3] = T(4.0) * (*h[0])[3] * (*h[1])[3] * (*h[2])[3] * (*h[3])[3];
+  return out;
+}
+}  // namespace
+
 void ImplicitGeometry::note_on_plane(Index v, Index p) {
   auto& on = verts_[v].on_planes;
   if (std::find(on.begin(), on.end(), p) == on.end()) on.push_back(p);
@@ -125,6 +152,11 @@ const std::array<Interval, 4>& ImplicitGeometry::vertex_interval(Index v) {
     if (vx.explicit_id >= 0) {
       const Vec3& p = points_[vx.explicit_id];
       vx.iv = {Interval(p.x), Interval(p.y), Interval(p.z), Interval(1.0)};
+    } else if (vx.centroid_of[0] >= 0) {
+      const std::array<Index, 4> of = vx.centroid_of;
+      std::array<std::array<Interval, 4>, 4> hs;
+      for (int i = 0; i < 4; ++i) hs[i] = vertex_interval(of[i]);
+      verts_[v].iv = centroid4<Interval>({&hs[0], &hs[1], &hs[2], &hs[3]});
     } else {
       Interval nd[3][4];
       for (int i = 0; i < 3; ++i) {
@@ -147,6 +179,11 @@ const std::array<ExactFloat, 4>& ImplicitGeometry::vertex_exact(Index v) {
     if (vx.explicit_id >= 0) {
       const Vec3& p = points_[vx.explicit_id];
       h = {ExactFloat(p.x), ExactFloat(p.y), ExactFloat(p.z), ExactFloat(1.0)};
+    } else if (vx.centroid_of[0] >= 0) {
+      const std::array<Index, 4> of = vx.centroid_of;
+      std::array<std::array<ExactFloat, 4>, 4> hs;
+      for (int i = 0; i < 4; ++i) hs[i] = vertex_exact(of[i]);
+      h = centroid4<ExactFloat>({&hs[0], &hs[1], &hs[2], &hs[3]});
     } else {
       const auto& a = plane_exact(vx.planes[0]);
       const auto& b = plane_exact(vx.planes[1]);

@@ -492,7 +492,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
         // for a coplanar neighbour, or the plane).
         bool on = true;
         if (!geo.is_explicit(v))
-          for (Index p : geo.tpi_planes(v)) on = on && geo.side(p, w) == Sign::kZero;
+          for (Index p : geo.tpi_planes(v)) on = on && p >= 0 && geo.side(p, w) == Sign::kZero;
         if (on && mesh.try_replace(v, w)) {
           ++st.rounded;
           ++moved;

@@ -14,7 +14,9 @@
 //    from v to the triangles of every face whose plane does not contain v. The faces through v must
 //    then be fans from v for both cells that share them, so v qualifies only if every face of the
 //    cell on a plane through v has v as a corner (no collinear vertex next to v) and no other cell
-//    has claimed a different fan vertex for it.
+//    has claimed a different fan vertex for it;
+//  * failing that, it is coned from an implicit apex: the exact centroid of four of its
+//    non-coplanar vertices.
 // The interior Steiner points (apexes) are removed later where possible (steiner_removal.h).
 #pragma once
 

@@ -45,6 +45,9 @@ class ImplicitGeometry {
   Index add_explicit_vertex(Index point);
   /// Adds the vertex where planes p, q, r meet (they must meet in one point: caller's duty).
   Index add_tpi_vertex(Index p, Index q, Index r);
+  /// Adds the vertex at the centroid of four vertices (exact homogeneous coordinates). Inside a
+  /// convex cell with those four non-coplanar vertices it is strictly inside the cell.
+  Index add_centroid_vertex(const std::array<Index, 4>& of);
   /// Records that vertex v lies on plane p (a fact known combinatorially), so side() returns
   /// ZERO without arithmetic.
   void note_on_plane(Index v, Index p);
@@ -78,7 +81,8 @@ class ImplicitGeometry {
   };
   struct Vertex {
     Index explicit_id = -1;
-    std::array<Index, 3> planes{{-1, -1, -1}};
+    std::array<Index, 3> planes{{-1, -1, -1}};  ///< TPI planes; all -1 for explicit and centroid vertices
+    std::array<Index, 4> centroid_of{{-1, -1, -1, -1}};
     std::vector<Index> on_planes;  // planes known to contain the vertex
     bool iv_ready = false;
     std::array<Interval, 4> iv;  // homogeneous (X, Y, Z, W)
