@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <string>
 
 #include "bsptet/errors.h"
@@ -13,6 +14,69 @@
 namespace bsptet {
 
 namespace {
+
+// The direction d (|d|_inf <= 1) that maximizes min_j m_j . d, by enumerating the vertices of the
+// 4-variable LP (d, s): max s, m_j . d >= s, -1 <= d_k <= 1. Small inputs only (a fallback).
+// Returns the margin s (<= 0: no direction sees every half-space).
+double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
+  struct Row {
+    double a[4], b;  // a . (d, s) = b when active
+  };
+  std::vector<Row> rows;
+  for (const Vec3& m : ms) rows.push_back({{m.x, m.y, m.z, -1.0}, 0.0});
+  for (int k = 0; k < 3; ++k)
+    for (double sg : {1.0, -1.0}) {
+      Row r{{0, 0, 0, 0}, 1.0};
+      r.a[k] = sg;
+      rows.push_back(r);
+    }
+  const std::size_t n = rows.size();
+  double best_s = -INFINITY;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      for (std::size_t k = j + 1; k < n; ++k)
+        for (std::size_t l = k + 1; l < n; ++l) {
+          double A[4][5];
+          const std::size_t idx[4] = {i, j, k, l};
+          for (int r = 0; r < 4; ++r) {
+            for (int c = 0; c < 4; ++c) A[r][c] = rows[idx[r]].a[c];
+            A[r][4] = rows[idx[r]].b;
+          }
+          bool singular = false;
+          for (int c = 0; c < 4 && !singular; ++c) {
+            int piv = c;
+            for (int r = c + 1; r < 4; ++r)
+              if (std::fabs(A[r][c]) > std::fabs(A[piv][c])) piv = r;
+            if (std::fabs(A[piv][c]) < 1e-12) {
+              singular = true;
+              break;
+            }
+            for (int cc = 0; cc < 5; ++cc) std::swap(A[c][cc], A[piv][cc]);
+            for (int r = 0; r < 4; ++r)
+              if (r != c) {
+                const double f = A[r][c] / A[c][c];
+                for (int cc = c; cc < 5; ++cc) A[r][cc] -= f * A[c][cc];
+              }
+          }
+          if (singular) continue;
+          const double x[4] = {A[0][4] / A[0][0], A[1][4] / A[1][1], A[2][4] / A[2][2], A[3][4] / A[3][3]};
+          if (!(x[3] > best_s)) continue;
+          bool feasible = true;
+          for (const Row& r : rows) {
+            const double lhs = r.a[0] * x[0] + r.a[1] * x[1] + r.a[2] * x[2] + r.a[3] * x[3];
+            // m . d - s >= 0 for half-spaces; |d_k| <= 1 for the box (a . x <= b).
+            if (r.a[3] != 0 ? lhs < -1e-12 : lhs > r.b + 1e-12) {
+              feasible = false;
+              break;
+            }
+          }
+          if (feasible) {
+            best_s = x[3];
+            *best = {x[0], x[1], x[2]};
+          }
+        }
+  return best_s;
+}
 
 // The working tet complex: tets and boundary faces with vertex -> element lists.
 class TetComplex {
@@ -153,14 +217,27 @@ class TetComplex {
   /// Moves surface Steiner point v to a double point just inside (header comment). Returns false
   /// when no candidate passes the exact checks.
   std::string why;  ///< why the last relocate() failed
-  bool relocate(Index v) {
-    std::map<Index, std::vector<std::array<Index, 3>>> groups;  // input triangle -> faces (v, x, y)
-    for (Index id : vb_[v]) {
-      std::array<Index, 3> f = faces_[id];
-      while (f[0] != v) std::rotate(f.begin(), f.begin() + 1, f.end());
-      groups[label_[id]].push_back(f);
-    }
-    if (groups.empty() || groups.size() > 2) return fail("its surface faces lie in " + std::to_string(groups.size()) + " input triangles");
+  std::int64_t merged = 0;  ///< interior points removed with a relocated surface point
+  /// Removes v and the Steiner points `also` (any of them may be on the surface) and cones their
+  /// cavity from one new double point w (header comment: RELOCATE). The surface faces that touch a
+  /// removed point are re-triangulated per input triangle: the region's boundary cycle, removed
+  /// points dropped (they must be collinear with their neighbours there: on an input edge), by
+  /// exact ear clipping.
+  bool relocate(Index v, const std::vector<Index>& also = {}) {
+    std::vector<Index> removed{v};
+    for (Index z : also)
+      if (z >= np_ && z != v) removed.push_back(z);
+    std::sort(removed.begin(), removed.end());
+    removed.erase(std::unique(removed.begin(), removed.end()), removed.end());
+    auto is_removed = [&](Index x) { return std::binary_search(removed.begin(), removed.end(), x); };
+    // Surface faces touching a removed point, per input triangle.
+    std::vector<Index> fset;
+    for (Index z : removed)
+      for (Index id : vb_[z]) fset.push_back(id);
+    std::sort(fset.begin(), fset.end());
+    fset.erase(std::unique(fset.begin(), fset.end()), fset.end());
+    std::map<Index, std::vector<std::array<Index, 3>>> groups;
+    for (Index id : fset) groups[label_[id]].push_back(faces_[id]);
     std::vector<std::array<Index, 3>> new_faces;
     std::vector<Index> new_labels;
     Vec3 dir{0, 0, 0};
@@ -168,24 +245,41 @@ class TetComplex {
       const Index plane = tri_plane_[t];
       const int axis = geo_.projection_axis(plane);
       const Sign s0 = geo_.orient2d(fs[0][0], fs[0][1], fs[0][2], axis);
+      std::set<std::pair<Index, Index>> edges;
+      for (const auto& f : fs)
+        for (int k = 0; k < 3; ++k) edges.insert({f[k], f[(k + 1) % 3]});
       std::map<Index, Index> next;
-      std::map<Index, int> has_prev;
-      for (const auto& f : fs) next[f[1]] = f[2], has_prev[f[2]] = 1;
-      Index start = fs[0][1];
-      if (groups.size() == 2) {
-        start = -1;
-        for (const auto& kv : next)
-          if (!has_prev.count(kv.first)) start = kv.first;
-        if (start < 0) return fail("its surface faces on an input edge do not form a path");
-      } else {
-        start = next.begin()->first;  // deterministic
+      for (const auto& [x, y] : edges)
+        if (!edges.count({y, x})) {
+          if (next.count(x)) return fail("its surface region touches itself at a vertex");
+          next[x] = y;
+        }
+      if (next.empty()) return fail("its surface region has no boundary");
+      std::vector<Index> cycle{next.begin()->first};
+      for (Index x = next.begin()->first;;) {
+        auto it = next.find(x);
+        if (it == next.end()) return fail("its surface region's boundary is not closed");
+        x = it->second;
+        if (x == cycle[0]) break;
+        cycle.push_back(x);
+        if (cycle.size() > next.size()) return fail("its surface region's boundary is not one cycle");
       }
-      std::vector<Index> poly{start};
-      for (Index x = start; next.count(x);) {
-        x = next[x];
-        if (x == start) break;
-        poly.push_back(x);
-        if (poly.size() > fs.size() + 1) return fail("its surface faces do not form a simple polygon");
+      if (cycle.size() != next.size()) return fail("its surface region has a hole");
+      // Drop removed points from the boundary: only where they are flat (on an input edge).
+      std::vector<Index> poly;
+      const std::size_t nc = cycle.size();
+      for (std::size_t i = 0; i < nc; ++i) {
+        const Index x = cycle[i];
+        if (!is_removed(x)) {
+          poly.push_back(x);
+          continue;
+        }
+        // Its neighbours on the cycle that stay.
+        std::size_t pi = (i + nc - 1) % nc, ni = (i + 1) % nc;
+        while (is_removed(cycle[pi]) && pi != i) pi = (pi + nc - 1) % nc;
+        while (is_removed(cycle[ni]) && ni != i) ni = (ni + 1) % nc;
+        if (pi == i || geo_.orient2d(cycle[pi], x, cycle[ni], axis) != Sign::kZero)
+          return fail("a removed point is a corner of its surface region");
       }
       if (poly.size() < 3) return fail("its surface polygon has fewer than 3 vertices");
       // Ear clipping of a simple polygon (possibly with flat vertices): an ear is strictly convex
@@ -215,7 +309,10 @@ class TetComplex {
       if (geo_.orient2d(poly[0], poly[1], poly[2], axis) != s0) return fail("degenerate last ear");
       new_faces.push_back({poly[0], poly[1], poly[2]});
       new_labels.push_back(t);
-      // Inward unit normal of input triangle t.
+      // Inward unit normal of input triangle t (for the faces at v).
+      bool at_v = false;
+      for (const auto& f : fs) at_v = at_v || f[0] == v || f[1] == v || f[2] == v;
+      if (!at_v) continue;
       const Vec3 a = surface_.point(surface_.tri[3 * t]), b = surface_.point(surface_.tri[3 * t + 1]),
                  c = surface_.point(surface_.tri[3 * t + 2]);
       const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, wx = c.x - a.x, wy = c.y - a.y, wz = c.z - a.z;
@@ -223,6 +320,38 @@ class TetComplex {
       const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
       dir.x -= nx / len, dir.y -= ny / len, dir.z -= nz / len;
     }
+    // The cavity: the tets of the removed points. Its boundary faces without a removed point, and
+    // the new surface triangles, are coned from w.
+    std::vector<Index> cavity;
+    for (Index z : removed)
+      for (Index id : vt_[z]) cavity.push_back(id);
+    std::sort(cavity.begin(), cavity.end());
+    cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
+    auto cavity_bases = [&](const std::vector<Index>& cav) {
+      std::vector<std::array<Index, 3>> out;  // outward faces of the cavity
+      std::map<std::array<Index, 3>, int> count;
+      std::vector<std::array<Index, 3>> all;
+      for (Index id : cav) {
+        const auto& t = tets_[id];
+        const std::array<std::array<Index, 3>, 4> fs = {{{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+        for (const auto& f : fs) {
+          if (is_removed(f[0]) || is_removed(f[1]) || is_removed(f[2])) continue;
+          std::array<Index, 3> key = f;
+          std::sort(key.begin(), key.end());
+          ++count[key];
+          all.push_back(f);
+        }
+      }
+      for (const auto& f : all) {
+        std::array<Index, 3> key = f;
+        std::sort(key.begin(), key.end());
+        if (count[key] == 1) out.push_back(f);
+      }
+      for (const auto& f : new_faces) out.push_back(f);
+      return out;
+    };
+    std::vector<std::array<Index, 3>> bases = cavity_bases(cavity);
+
     // Candidate points w = v + eps * d, found in doubles, decided exactly below. Every cavity face
     // (v's link faces and the new surface triangles) is a half-space m . (w - a) > 0 (m unit). Faces
     // whose plane passes (nearly) through v constrain the direction d; the others bound eps.
@@ -242,19 +371,14 @@ class TetComplex {
       hs.push_back({m, a, m.x * (vr.x - a.x) + m.y * (vr.y - a.y) + m.z * (vr.z - a.z)});
     };
     double lref = 0;
-    for (Index id : vt_[v]) {
-      const auto& t = tets_[id];
-      const int k = static_cast<int>(std::find(t.begin(), t.end(), v) - t.begin());
-      std::array<Index, 4> u = t;
-      std::swap(u[k], u[3]);  // v last; an odd permutation unless k == 3
-      const Vec3 a = geo_.rounded(u[0]), b = geo_.rounded(u[1]), c = geo_.rounded(u[2]);
-      add_half_space(a, b, c, k == 3 ? 1.0 : -1.0);
+    for (const auto& f : bases) {
+      // Outward face (a, b, c): w must make (a, c, b, w) positive.
+      const Vec3 a = geo_.rounded(f[0]), b = geo_.rounded(f[2]), c = geo_.rounded(f[1]);
+      add_half_space(a, b, c, 1.0);
       for (const Vec3& q : {a, b, c})
         lref = std::max(lref, std::sqrt((q.x - vr.x) * (q.x - vr.x) + (q.y - vr.y) * (q.y - vr.y) +
                                         (q.z - vr.z) * (q.z - vr.z)));
     }
-    for (const auto& f : new_faces)
-      add_half_space(geo_.rounded(f[0]), geo_.rounded(f[2]), geo_.rounded(f[1]), 1.0);
     auto unit = [](Vec3 d) {
       const double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
       return len > 0 ? Vec3{d.x / len, d.y / len, d.z / len} : Vec3{0, 0, 0};
@@ -277,6 +401,10 @@ class TetComplex {
       for (std::size_t i = 0; i < near.size(); ++i)
         for (std::size_t j = i + 1; j < near.size(); ++j)
           dirs.push_back(unit({near[i].x + near[j].x, near[i].y + near[j].y, near[i].z + near[j].z}));
+      if (near.size() <= 30) {
+        Vec3 d;
+        if (best_direction(near, &d) > 0) dirs.push_back(unit(d));
+      }
       std::vector<std::pair<double, Vec3>> scored;
       for (const Vec3& d : dirs) {
         double score = INFINITY;
@@ -297,7 +425,17 @@ class TetComplex {
     }
     // Fallbacks for a v inside a slab thinner than a double's precision: points towards its
     // neighbours off the surface, and towards the centroids of its tets.
-    for (Index id : vt_[v]) {
+    if (removed.size() > 1) {
+      Vec3 c{0, 0, 0};
+      for (Index z : removed) {
+        const Vec3 q = geo_.rounded(z);
+        c = {c.x + q.x / removed.size(), c.y + q.y / removed.size(), c.z + q.z / removed.size()};
+      }
+      candidates.push_back(c);
+      for (double f : {0.5, 0.1})
+        candidates.push_back({vr.x + f * (c.x - vr.x), vr.y + f * (c.y - vr.y), vr.z + f * (c.z - vr.z)});
+    }
+    for (Index id : cavity) {
       Vec3 c{0, 0, 0};
       for (Index x : tets_[id]) {
         const Vec3 q = geo_.rounded(x);
@@ -324,45 +462,52 @@ class TetComplex {
       const Vec3 w = candidates[attempt];
       // Double pre-checks are not exact; everything is decided on the new vertex below.
       const Index wid = geo_.add_explicit_point(w);
-      bool ok = true;
+      // Cone from w; a face w does not see is removed from the cavity's boundary by taking the tet
+      // beyond it into the cavity (never across the surface), a few times at most.
+      std::vector<Index> cav = cavity;
+      std::vector<std::array<Index, 3>> bs = bases;
       std::vector<std::array<Index, 4>> repl;
-      for (Index id : vt_[v]) {
-        std::array<Index, 4> t = tets_[id];
-        for (Index& x : t)
-          if (x == v) x = wid;
-        if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) {
-          ok = false;
+      bool ok = false;
+      const int max_grow = attempt < 12 ? 16 : 0;  // bounded work per candidate
+      for (int grow = 0; grow <= max_grow; ++grow) {
+        repl.clear();
+        std::array<Index, 3> bad{-1, -1, -1};
+        for (const auto& f : bs) {
+          const std::array<Index, 4> t{f[0], f[2], f[1], wid};
+          if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) {
+            bad = f;
+            break;
+          }
+          repl.push_back(t);
+        }
+        if (bad[0] < 0) {
+          ok = true;
           break;
         }
-        repl.push_back(t);
-      }
-      for (std::size_t i = 0; ok && i < new_faces.size(); ++i) {
-        const auto& f = new_faces[i];  // outward: (f0, f2, f1, w) is positive
-        const std::array<Index, 4> t{f[0], f[2], f[1], wid};
-        if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) ok = false;
-        repl.push_back(t);
-      }
-      if (!ok) {
-        if (std::getenv("BSPTET_DEBUG")) {
-          int bad_old = 0, bad_new = 0;
-          for (Index id : vt_[v]) {
-            std::array<Index, 4> t = tets_[id];
-            for (Index& x : t) if (x == v) x = wid;
-            bad_old += geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive;
-          }
-          for (const auto& f : new_faces) bad_new += geo_.orient3d(f[0], f[2], f[1], wid) != Sign::kPositive;
-          std::fprintf(stderr, "relocate %d attempt %zu: bad old %d/%zu bad new %d/%zu\n", v, attempt, bad_old,
-                       vt_[v].size(), bad_new, new_faces.size());
+        // The tet beyond `bad`: it has all three vertices and is not in the cavity.
+        Index beyond = -1;
+        for (Index id : vt_[bad[0]]) {
+          const auto& t = tets_[id];
+          if (std::find(t.begin(), t.end(), bad[1]) != t.end() && std::find(t.begin(), t.end(), bad[2]) != t.end() &&
+              !std::binary_search(cav.begin(), cav.end(), id))
+            beyond = id;
         }
-        continue;
+        if (beyond < 0) break;  // a surface face (or a new one): w is on its wrong side
+        cav.insert(std::upper_bound(cav.begin(), cav.end(), beyond), beyond);
+        bs = cavity_bases(cav);
       }
-      const std::vector<Index> star = vt_[v];
-      for (Index id : star) kill_tet(id);
+      if (!ok) continue;
+      for (Index id : cav) kill_tet(id);
       for (const auto& t : repl) add_tet(t);
-      const std::vector<Index> fstar = vb_[v];
-      for (Index id : fstar) kill_face(id);
+      for (Index id : fset) kill_face(id);
       for (std::size_t i = 0; i < new_faces.size(); ++i) add_face(new_faces[i], new_labels[i]);
+      merged += static_cast<std::int64_t>(removed.size()) - 1;
       return true;
+    }
+    if (std::getenv("BSPTET_DEBUG")) {
+      std::fprintf(stderr, "no candidate for %d (%s) lref %g, %zu candidates, labels %zu:\n", v,
+                   geo_.is_explicit(v) ? "explicit" : "implicit", lref, candidates.size(), groups.size());
+      for (const auto& h : hs) std::fprintf(stderr, "  m (%.6f %.6f %.6f) dist %.3g\n", h.m.x, h.m.y, h.m.z, h.dist);
     }
     return fail("no double-precision point just inside keeps its tets positive");
   }
@@ -478,6 +623,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
   // inside.
   // A point that cannot move yet may be able to once its neighbours have moved or collapsed: retry
   // in rounds while anything changes.
+  std::map<Index, int> attempts;  // bounded work: a point gets at most 3 tries
   for (int round = 0;; ++round) {
     std::int64_t moved = 0;
     Index stuck = -1;
@@ -499,11 +645,32 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           continue;
         }
       }
+      if (++attempts[v] > 3) {
+        if (stuck < 0) stuck = v, why = mesh.why;
+        continue;
+      }
       bool ok = mesh.relocate(v);
-      if (!ok) {
-        bool smoothed = false;
-        for (Index z : mesh.neighbours(v)) smoothed = mesh.smooth_interior(z, np) || smoothed;
-        if (smoothed) ok = mesh.relocate(v);
+      if (!ok && attempts[v] == 1) {
+        // Take the interior Steiner points around v along (one ring, then two): a slab thinner
+        // than a double between them and v disappears with them.
+        for (const bool with_surface : {false, true}) {
+          std::vector<Index> ring{v};
+          for (int k = 1; k <= 1 && !ok; ++k) {
+            std::vector<Index> grown = ring;
+            for (Index z : ring)
+              for (Index y : mesh.neighbours(z))
+                if (y >= np && (with_surface || mesh.labels(y).empty())) grown.push_back(y);
+            std::sort(grown.begin(), grown.end());
+            grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
+            if (grown.size() == ring.size()) break;
+            ring = grown;
+            ok = mesh.relocate(v, ring);
+            if (std::getenv("BSPTET_DEBUG"))
+              std::fprintf(stderr, "v %d ring %d surface %d size %zu: %s\n", v, k, (int)with_surface, ring.size(),
+                           ok ? "ok" : mesh.why.c_str());
+          }
+          if (ok) break;
+        }
       }
       if (ok) {
         ++st.relocated;
@@ -555,6 +722,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     ++st.rounded_moved;
   }
   for (Index v : steiner_vertices()) st.boundary_steiner_after += !mesh.labels(v).empty();
+  st.collapsed += mesh.merged;
   progress(1.0);
   if (stats_out) *stats_out = st;
   return mesh.alive_tets();
