@@ -218,6 +218,8 @@ class TetComplex {
   /// when no candidate passes the exact checks.
   std::string why;  ///< why the last relocate() failed
   std::int64_t merged = 0;  ///< interior points removed with a relocated surface point
+  int grow_limit = 16;      ///< cavity growth steps per candidate point (relocate)
+  std::size_t max_candidates = 1000;
   /// Removes v and the Steiner points `also` (any of them may be on the surface) and cones their
   /// cavity from one new double point w (header comment: RELOCATE). The surface faces that touch a
   /// removed point are re-triangulated per input triangle: the region's boundary cycle, removed
@@ -458,6 +460,7 @@ class TetComplex {
       }
       return fail("no direction into the solid sees all its faces");
     }
+    if (candidates.size() > max_candidates) candidates.resize(max_candidates);
     for (std::size_t attempt = 0; attempt < candidates.size(); ++attempt) {
       const Vec3 w = candidates[attempt];
       // Double pre-checks are not exact; everything is decided on the new vertex below.
@@ -468,7 +471,7 @@ class TetComplex {
       std::vector<std::array<Index, 3>> bs = bases;
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
-      const int max_grow = attempt < 12 ? 16 : 0;  // bounded work per candidate
+      const int max_grow = attempt < 12 ? grow_limit : 0;  // bounded work per candidate
       for (int grow = 0; grow <= max_grow; ++grow) {
         repl.clear();
         std::array<Index, 3> bad{-1, -1, -1};
@@ -691,7 +694,24 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
                              std::to_string(mesh.labels(stuck)[0]) + " inside the solid: " + why);
     }
   }
-  collapse_passes(0.5, 0.9);
+  collapse_passes(0.5, 0.8);
+  // Merge: an interior Steiner point that cannot collapse is replaced, with its interior Steiner
+  // neighbours, by one new point (a cavity re-coned from it), then collapses are tried again.
+  mesh.grow_limit = 2;
+  mesh.max_candidates = 24;
+  for (int pass = 0; pass < 3; ++pass) {
+    std::int64_t merged_before = mesh.merged;
+    for (Index z : steiner_vertices()) {
+      check_cancel();
+      if (!mesh.used(z) || !mesh.labels(z).empty()) continue;
+      std::vector<Index> ring;
+      for (Index y : mesh.neighbours(z))
+        if (y >= np && mesh.labels(y).empty()) ring.push_back(y);
+      if (!ring.empty()) mesh.relocate(z, ring);
+    }
+    if (mesh.merged == merged_before) break;
+    collapse_passes(0.8 + 0.03 * pass, 0.83 + 0.03 * pass);
+  }
 
   // Round the implicit points left.
   for (Index v : steiner_vertices()) {
