@@ -194,3 +194,24 @@ def test_progress_bar_is_silent_for_short_runs_and_draws_for_long_ones():
     p = Progress(enabled=False, stream=quiet, delay=0.0)
     p("x", 1.0)
     assert quiet.getvalue() == ""
+
+
+@pytest.mark.parametrize("cad", ["tests/data/cad/red_cube_blue_cylinder.step", "resources/samples/bracket.step"])
+def test_mesh_cad_solid_is_valid(cli, tmp_path, cad):
+    from FemBspTet.freecad_env import freecad_available
+
+    if not freecad_available():
+        pytest.skip("FreeCAD is not installed")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = tmp_path / "part.inp"
+    stats_file = tmp_path / "stats.json"
+    r = run(cli, "mesh", os.path.join(root, cad), "-o", out, "--stats-json", stats_file, "--quiet")
+    assert r.returncode == 0, r.stderr
+    stats = json.loads(stats_file.read_text())
+    # `mesh` checks its mesh exactly before writing; the file must hold what the stats say.
+    from FemBspTet.volume_io import read_tet_mesh
+
+    mesh = read_tet_mesh(str(out))
+    assert stats["valid"] is True and stats["boundary_steiner_points"] == 0
+    assert len(mesh.tets) == stats["tets"] and len(mesh.points) == stats["points"]
+    assert stats["solids"] >= 1
