@@ -460,6 +460,23 @@ class TetComplex {
       }
       return fail("no direction into the solid sees all its faces");
     }
+    // Deepest first: a point that hugs a face becomes an obstacle for the next relocation (a plane
+    // a few ulps away), so order by the clearance to the cavity faces, estimated in doubles (the
+    // exact checks below decide). Candidates that look outside go last, in their order.
+    {
+      std::vector<std::pair<double, std::size_t>> order;
+      for (std::size_t i = 0; i < candidates.size(); ++i) {
+        const Vec3& w = candidates[i];
+        double clearance = INFINITY;
+        for (const auto& h : hs)
+          clearance = std::min(clearance, h.m.x * (w.x - h.a.x) + h.m.y * (w.y - h.a.y) + h.m.z * (w.z - h.a.z));
+        order.push_back({clearance > 0 ? -clearance : INFINITY, i});
+      }
+      std::stable_sort(order.begin(), order.end());
+      std::vector<Vec3> sorted;
+      for (const auto& [key, i] : order) sorted.push_back(candidates[i]);
+      candidates.swap(sorted);
+    }
     if (candidates.size() > max_candidates) candidates.resize(max_candidates);
     for (std::size_t attempt = 0; attempt < candidates.size(); ++attempt) {
       const Vec3 w = candidates[attempt];
