@@ -272,6 +272,7 @@ int ImplicitGeometry::projection_axis(Index p, Sign* normal_sign) {
 Vec3 ImplicitGeometry::rounded(Index v) {
   const Vertex& vx = verts_[v];
   if (vx.explicit_id >= 0) return points_[vx.explicit_id];
+  if (vx.rounded_ready) return vx.rounded;
   const auto& h = vertex_exact(v);
   const mpq_class w = h[3].to_mpq();
   double out[3];
@@ -286,7 +287,9 @@ Vec3 ImplicitGeometry::rounded(Index v) {
     }
     out[k] = best;
   }
-  return {out[0], out[1], out[2]};
+  verts_[v].rounded = {out[0], out[1], out[2]};
+  verts_[v].rounded_ready = true;
+  return verts_[v].rounded;
 }
 
 }  // namespace bsptet

@@ -330,9 +330,8 @@ class TetComplex {
     std::sort(cavity.begin(), cavity.end());
     cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
     auto cavity_bases = [&](const std::vector<Index>& cav) {
-      std::vector<std::array<Index, 3>> out;  // outward faces of the cavity
-      std::map<std::array<Index, 3>, int> count;
-      std::vector<std::array<Index, 3>> all;
+      // Outward faces of the cavity: faces of its tets, without a removed point, that appear once.
+      std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
       for (Index id : cav) {
         const auto& t = tets_[id];
         const std::array<std::array<Index, 3>, 4> fs = {{{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
@@ -340,14 +339,16 @@ class TetComplex {
           if (is_removed(f[0]) || is_removed(f[1]) || is_removed(f[2])) continue;
           std::array<Index, 3> key = f;
           std::sort(key.begin(), key.end());
-          ++count[key];
-          all.push_back(f);
+          all.push_back({key, f});
         }
       }
-      for (const auto& f : all) {
-        std::array<Index, 3> key = f;
-        std::sort(key.begin(), key.end());
-        if (count[key] == 1) out.push_back(f);
+      std::sort(all.begin(), all.end());
+      std::vector<std::array<Index, 3>> out;
+      for (std::size_t i = 0; i < all.size();) {
+        std::size_t j = i + 1;
+        while (j < all.size() && all[j].first == all[i].first) ++j;
+        if (j - i == 1) out.push_back(all[i].second);
+        i = j;
       }
       for (const auto& f : new_faces) out.push_back(f);
       return out;
@@ -714,8 +715,8 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
   collapse_passes(0.5, 0.8);
   // Merge: an interior Steiner point that cannot collapse is replaced, with its interior Steiner
   // neighbours, by one new point (a cavity re-coned from it), then collapses are tried again.
-  mesh.grow_limit = 2;
-  mesh.max_candidates = 24;
+  mesh.grow_limit = 0;
+  mesh.max_candidates = 8;
   for (int pass = 0; pass < 3; ++pass) {
     std::int64_t merged_before = mesh.merged;
     for (Index z : steiner_vertices()) {
@@ -724,6 +725,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       std::vector<Index> ring;
       for (Index y : mesh.neighbours(z))
         if (y >= np && mesh.labels(y).empty()) ring.push_back(y);
+      if (ring.size() > 6) ring.resize(6);  // bounded work: the six lowest ids
       if (!ring.empty()) mesh.relocate(z, ring);
     }
     if (mesh.merged == merged_before) break;

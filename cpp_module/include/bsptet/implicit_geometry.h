@@ -87,6 +87,8 @@ class ImplicitGeometry {
     bool iv_ready = false;
     std::array<Interval, 4> iv;  // homogeneous (X, Y, Z, W)
     std::unique_ptr<std::array<ExactFloat, 4>> exact;
+    bool rounded_ready = false;
+    Vec3 rounded;  ///< cache of rounded()
   };
   void prepare_plane(Index p);
   const std::array<ExactFloat, 4>& plane_exact(Index p);
