@@ -69,21 +69,22 @@ PYBIND11_MODULE(_bsptet, m) {
   m.attr("__version__") = FEMBSPTET_VERSION;
 
   // Core errors reach Python as these types; FemBspTet.core turns them into FemBspTet.errors.
-  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
-  static py::exception<MeshingError> meshing_error(m, "MeshingError", PyExc_RuntimeError);
+  static py::exception<void> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<void> meshing_error(m, "MeshingError", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
+    // The Python exception carries the core's error code name and element index.
+    auto raise = [](const py::exception<void>& type, const Error& e) {
+      py::object exc = py::reinterpret_borrow<py::object>(type.ptr())(e.what());
+      exc.attr("code") = error_code_name(e.code());
+      exc.attr("index") = e.index();
+      PyErr_SetObject(type.ptr(), exc.ptr());
+    };
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
-      py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
-      exc.attr("code") = error_code_name(e.code());
-      exc.attr("index") = e.index();
-      PyErr_SetObject(input_error.ptr(), exc.ptr());
+      raise(input_error, e);
     } catch (const MeshingError& e) {
-      py::object exc = py::reinterpret_borrow<py::object>(meshing_error.ptr())(e.what());
-      exc.attr("code") = error_code_name(e.code());
-      exc.attr("index") = e.index();
-      PyErr_SetObject(meshing_error.ptr(), exc.ptr());
+      raise(meshing_error, e);
     }
   });
 

@@ -140,14 +140,7 @@ CellTets tetrahedralize_cells(BspComplex& bsp, const CellLabels& labels) {
     if (kind[c] == 0) {
       // Last resort: an implicit apex, the exact centroid of four non-coplanar cell vertices
       // (strictly inside the convex cell). Removed or rounded with the other Steiner points.
-      for (std::size_t i = 2; i < cv.size() && kind[c] == 0; ++i)
-        for (std::size_t j = i + 1; j < cv.size(); ++j)
-          if (geo.orient3d(cv[0], cv[1], cv[i], cv[j]) != Sign::kZero) {
-            kind[c] = 2;
-            apex_of[c] = geo.add_centroid_vertex({cv[0], cv[1], cv[i], cv[j]});
-            break;
-          }
-      for (std::size_t h = 1; h < cv.size() && kind[c] == 0; ++h)  // cv[0], cv[1] on a line with the rest
+      for (std::size_t h = 1; h < cv.size() && kind[c] == 0; ++h)
         for (std::size_t i = h + 1; i < cv.size() && kind[c] == 0; ++i)
           for (std::size_t j = i + 1; j < cv.size(); ++j)
             if (geo.orient3d(cv[0], cv[h], cv[i], cv[j]) != Sign::kZero) {

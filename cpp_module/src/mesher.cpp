@@ -191,7 +191,6 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   stage_time("planes", t0);
 
   t0 = Clock::now();
-  const std::vector<Index> tri_plane_copy = tri_plane;
   BspComplex bsp(geo, surface, std::move(tri_plane));
   bsp.set_debug_checks(options.debug_checks);
   if (options.debug_checks) bsp.check_consistency();
@@ -219,7 +218,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   so.progress = [&](double f) { progress("removing Steiner points", f); };
   SteinerRemovalStats ss;
   const std::vector<std::array<Index, 4>> tets =
-      remove_steiner_points(geo, surface, tri_plane_copy, cell_tets, so, &ss);
+      remove_steiner_points(geo, surface, bsp.triangle_planes(), cell_tets, so, &ss);
   stage_time("steiner_removal", t0);
 
   t0 = Clock::now();

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
@@ -137,10 +135,10 @@ class TetComplex {
     return out;  // ids below np_ (input points) already come first
   }
 
-  /// The support rule (header comment): may Steiner point v move onto vertex u?
-  bool may_move_onto(Index v, Index u) const {
+  /// The support rule (header comment): may Steiner point v, whose labels() are `lv`, move onto
+  /// vertex u?
+  bool may_move_onto(Index v, const std::vector<Index>& lv, Index u) const {
     if (v < np_) return false;
-    const std::vector<Index> lv = labels(v);
     if (lv.empty()) return true;
     if (u < np_) {
       for (Index t : lv)
@@ -153,7 +151,11 @@ class TetComplex {
     return false;
   }
 
-  bool try_collapse(Index v, Index u) {
+  /// Puts u in place of v in every tet and surface face of v, if every new tet is positive. Tets
+  /// and faces that already contain u vanish (a collapse along the edge v-u); for a new vertex u
+  /// none do (v moves to u). Returns false, changing nothing, when a tet would not be positive.
+  bool try_substitute(Index v, Index u) {
+    grow();  // u may be a vertex just added to the geometry
     std::vector<std::array<Index, 4>> repl;
     const std::vector<Index> star = vt_[v];
     for (Index id : star) {
@@ -189,33 +191,6 @@ class TetComplex {
     return true;
   }
 
-  /// Replaces v by vertex w in every tet of v if all stay positive.
-  bool try_replace(Index v, Index w) {
-    std::vector<std::array<Index, 4>> repl;
-    for (Index id : vt_[v]) {
-      std::array<Index, 4> t = tets_[id];
-      for (Index& x : t)
-        if (x == v) x = w;
-      if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
-      repl.push_back(t);
-    }
-    const std::vector<Index> star = vt_[v];
-    for (Index id : star) kill_tet(id);
-    for (const auto& t : repl) add_tet(t);
-    const std::vector<Index> fstar = vb_[v];
-    for (Index id : fstar) {
-      std::array<Index, 3> f = faces_[id];
-      const Index lab = label_[id];
-      kill_face(id);
-      for (Index& x : f)
-        if (x == v) x = w;
-      add_face(f, lab);
-    }
-    return true;
-  }
-
-  /// Moves surface Steiner point v to a double point just inside (header comment). Returns false
-  /// when no candidate passes the exact checks.
   std::string why;  ///< why the last relocate() failed
   std::int64_t merged = 0;  ///< interior points removed with a relocated surface point
   int grow_limit = 16;      ///< cavity growth steps per candidate point (relocate)
@@ -453,14 +428,7 @@ class TetComplex {
       for (double f : {0.5, 0.1, 0.01})
         candidates.push_back({vr.x + f * (q.x - vr.x), vr.y + f * (q.y - vr.y), vr.z + f * (q.z - vr.z)});
     }
-    if (candidates.empty() || !(lref > 0)) {
-      if (std::getenv("BSPTET_DEBUG")) {
-        std::fprintf(stderr, "stuck %d (%s) lref %g:\n", v, geo_.is_explicit(v) ? "explicit" : "tpi", lref);
-        for (const auto& h : hs)
-          std::fprintf(stderr, "  m (%.6f %.6f %.6f) dist %.3g\n", h.m.x, h.m.y, h.m.z, h.dist);
-      }
-      return fail("no direction into the solid sees all its faces");
-    }
+    if (candidates.empty() || !(lref > 0)) return fail("no direction into the solid sees all its faces");
     // Deepest first: a point that hugs a face becomes an obstacle for the next relocation (a plane
     // a few ulps away), so order by the clearance to the cavity faces, estimated in doubles (the
     // exact checks below decide). Candidates that look outside go last, in their order.
@@ -525,33 +493,10 @@ class TetComplex {
       merged += static_cast<std::int64_t>(removed.size()) - 1;
       return true;
     }
-    if (std::getenv("BSPTET_DEBUG")) {
-      std::fprintf(stderr, "no candidate for %d (%s) lref %g, %zu candidates, labels %zu:\n", v,
-                   geo_.is_explicit(v) ? "explicit" : "implicit", lref, candidates.size(), groups.size());
-      for (const auto& h : hs) std::fprintf(stderr, "  m (%.6f %.6f %.6f) dist %.3g\n", h.m.x, h.m.y, h.m.z, h.dist);
-    }
     return fail("no double-precision point just inside keeps its tets positive");
   }
   bool fail(const std::string& reason) {
     why = reason;
-    return false;
-  }
-
-  /// Moves interior Steiner point z towards the centroid of its neighbours (exact check); used to
-  /// fatten a surface point's neighbourhood before moving it.
-  bool smooth_interior(Index z, Index first_steiner) {
-    if (z < first_steiner || !labels(z).empty()) return false;
-    const Vec3 r = geo_.rounded(z);
-    Vec3 c{0, 0, 0};
-    const auto nb = neighbours(z);
-    for (Index u : nb) {
-      const Vec3 p = geo_.rounded(u);
-      c = {c.x + p.x / nb.size(), c.y + p.y / nb.size(), c.z + p.z / nb.size()};
-    }
-    for (double a : {1.0, 0.7, 0.4, 0.2}) {
-      const Vec3 p{(1 - a) * r.x + a * c.x, (1 - a) * r.y + a * c.y, (1 - a) * r.z + a * c.z};
-      if (try_replace(z, geo_.add_explicit_point(p))) return true;
-    }
     return false;
   }
 
@@ -626,9 +571,10 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           progress(f0 + (f1 - f0) * (pass + static_cast<double>(i) / sv.size()) / (pass + 2));
         }
         if (!mesh.used(v)) continue;
+        const std::vector<Index> lv = mesh.labels(v);
         for (Index u : mesh.neighbours(v)) {
-          if (!mesh.may_move_onto(v, u)) continue;
-          if (mesh.try_collapse(v, u)) {
+          if (!mesh.may_move_onto(v, lv, u)) continue;
+          if (mesh.try_substitute(v, u)) {
             ++st.collapsed;
             changed = true;
             break;
@@ -660,7 +606,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
         bool on = true;
         if (!geo.is_explicit(v))
           for (Index p : geo.tpi_planes(v)) on = on && p >= 0 && geo.side(p, w) == Sign::kZero;
-        if (on && mesh.try_replace(v, w)) {
+        if (on && mesh.try_substitute(v, w)) {
           ++st.rounded;
           ++moved;
           continue;
@@ -686,9 +632,6 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
             if (grown.size() == ring.size()) break;
             ring = grown;
             ok = mesh.relocate(v, ring);
-            if (std::getenv("BSPTET_DEBUG"))
-              std::fprintf(stderr, "v %d ring %d surface %d size %zu: %s\n", v, k, (int)with_surface, ring.size(),
-                           ok ? "ok" : mesh.why.c_str());
           }
           if (ok) break;
         }
@@ -737,7 +680,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     if (geo.is_explicit(v)) continue;
     check_cancel();
     const Vec3 r = geo.rounded(v);
-    bool done = mesh.try_replace(v, geo.add_explicit_point(r));
+    bool done = mesh.try_substitute(v, geo.add_explicit_point(r));
     if (done) {
       ++st.rounded;
       continue;
@@ -750,7 +693,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     }
     for (double a : {0.05, 0.2, 0.4, 0.6, 0.8, 0.95}) {
       const Vec3 p{(1 - a) * r.x + a * centroid.x, (1 - a) * r.y + a * centroid.y, (1 - a) * r.z + a * centroid.z};
-      if ((done = mesh.try_replace(v, geo.add_explicit_point(p)))) break;
+      if ((done = mesh.try_substitute(v, geo.add_explicit_point(p)))) break;
     }
     if (!done)
       throw MeshingError(ErrorCode::kInternal, "steiner", v,

@@ -78,6 +78,8 @@ class BspComplex {
   const std::vector<BspCell>& cells() const { return cells_; }
   const BspStats& stats() const { return stats_; }
   ImplicitGeometry& geometry() { return geo_; }
+  /// The plane of each input triangle.
+  const std::vector<Index>& triangle_planes() const { return tri_plane_; }
   /// Vertex k of input triangle t (input point ids are vertex ids).
   Index triangle_vertex(Index t, int k) const { return surface_.tri[3 * t + k]; }
 
