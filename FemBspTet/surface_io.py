@@ -443,7 +443,8 @@ def _merge_exact(corners):
 
 def _read_stl_binary(path, data, ntri):
     records = np.frombuffer(data, dtype=_STL_RECORD, count=ntri, offset=84)
-    corners = records["corners"].reshape(-1, 3).astype(np.float64)
+    with np.errstate(invalid="ignore"):  # NaN float32 values: found just below
+        corners = records["corners"].reshape(-1, 3).astype(np.float64)
     bad = ~np.isfinite(corners).all(axis=1)
     if bad.any():
         c = int(np.flatnonzero(bad)[0])
@@ -655,11 +656,14 @@ def _obj_faces_slow(fsrc):
         for token in row:
             head = token.partition("/")[0]
             try:
-                int(head)
+                value = int(head)
             except ValueError:
                 raise InputError(f"cannot read {token!r} as a vertex reference "
                                  f"('i', 'i/t', 'i//n' or 'i/t/n' with integer i)",
                                  where=fsrc.where(i, f"face {i}")) from None
+            if not -(2**63) <= value < 2**63:
+                raise InputError(f"face {i}: vertex index {value} is out of range",
+                                 where=fsrc.where(i, f"face {i}"))
     return np.array([[int(t.partition("/")[0]) for t in row] for row in rows],
                     dtype=np.int64).reshape(-1, 3)
 
@@ -860,16 +864,29 @@ def _ply_ascii_faces(src, start, elem, vertex_list):
                 col += 1
         if ok:
             idx = cols[vertex_list]
-            if (idx == np.round(idx)).all():
+            if (idx == np.round(idx)).all() and (np.abs(idx) < 2.0**62).all():
                 tags = cols.get("face_tag")
-                if tags is not None and not (tags == np.round(tags)).all():
+                if tags is not None and not ((tags == np.round(tags)).all()
+                                             and (np.abs(tags) < 2.0**31).all()):
                     tags = None
                 return (idx.astype(np.int64),
                         None if tags is None else tags.astype(np.int32))
     values = _ply_ascii_walk(src, start, elem, "face", vertex_list=vertex_list)
-    tri = np.asarray(values[vertex_list], dtype=np.int64).reshape(-1, 3)
+    tri = _ply_integers(values[vertex_list], src.path, "vertex index", np.int64).reshape(-1, 3)
     tags = values.get("face_tag")
-    return tri, (None if tags is None else np.asarray(tags, dtype=np.int32))
+    return tri, (None if tags is None else _ply_integers(tags, src.path, "face tag", np.int32))
+
+
+def _ply_integers(values, path, what, dtype):
+    """``values`` (numbers of a PLY face property) as integers of ``dtype``; InputError if some
+    are not integers or do not fit."""
+    arr = np.asarray(values, dtype=np.float64).reshape(-1)
+    limit = 2.0**62 if dtype is np.int64 else 2.0**31  # exact in float64, below the type's range
+    bad = ~np.isfinite(arr) | (arr != np.round(arr)) | (np.abs(arr) >= limit)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputError(f"face {what} {arr[i]!r} is not an integer in range", where=path)
+    return arr.astype(dtype)
 
 
 def _ply_ascii_walk(src, start, elem, what, vertex_list=None):
@@ -938,8 +955,9 @@ def _ply_binary(path, data, offset, endian, elements, vertex_list):
             offset += elem.count * dtype.itemsize
             if elem.name == "vertex":
                 names = [n for n, _ in elem.props]
-                points = np.stack([arr[f"p{names.index(a)}"].astype(np.float64)
-                                   for a in "xyz"], axis=1)
+                with np.errstate(invalid="ignore"):  # NaN values are reported later
+                    points = np.stack([arr[f"p{names.index(a)}"].astype(np.float64)
+                                       for a in "xyz"], axis=1)
                 out["points"] = (points, _ByteWhere(path, "vertex", start, dtype.itemsize))
             continue
         if elem.name == "face":
@@ -951,12 +969,13 @@ def _ply_binary(path, data, offset, endian, elements, vertex_list):
         values, starts, offset = _ply_binary_walk(path, data, offset, endian, elem,
                                                   vertex_list if elem.name == "face" else None)
         if elem.name == "vertex":
-            points = np.stack([np.asarray(values[a], dtype=np.float64) for a in "xyz"], axis=1)
+            with np.errstate(invalid="ignore"):  # NaN values are reported later
+                points = np.stack([np.asarray(values[a], dtype=np.float64) for a in "xyz"], axis=1)
             out["points"] = (points, _ByteWhere(path, "vertex", starts))
         elif elem.name == "face":
-            tri = np.asarray(values[vertex_list], dtype=np.int64).reshape(-1, 3)
+            tri = _ply_integers(values[vertex_list], path, "vertex index", np.int64).reshape(-1, 3)
             tags = values.get("face_tag")
-            tags = None if tags is None else np.asarray(tags, dtype=np.int32)
+            tags = None if tags is None else _ply_integers(tags, path, "face tag", np.int32)
             out["face"] = (tri, tags, _ByteWhere(path, "face", starts))
     if offset != len(data):
         raise InputError(f"{len(data) - offset} bytes of unexpected data after the last "

@@ -471,7 +471,11 @@ def _read_vtu(path, data):
         parray = piece.find("Points/DataArray")
         if parray is None:
             raise InputError("no <Points><DataArray>", where=f"{path}: Piece {p}")
-        ncomp = int(parray.get("NumberOfComponents", "3"))
+        try:
+            ncomp = int(parray.get("NumberOfComponents", "3"))
+        except ValueError:
+            raise InputError("NumberOfComponents of the points is not an integer",
+                             where=reader.where(parray, "Points")) from None
         if ncomp != 3:
             raise InputError(f"points have {ncomp} components; need 3",
                              where=reader.where(parray, "Points"))
@@ -664,6 +668,12 @@ def _check_integral(src, start, column, what, row_name, rows=None):
         k = start + i if rows is None else rows[i]
         raise InputError(f"{what} {column[i]!r} is not an integer",
                          where=src.where(k, f"{row_name} {i}"))
+    huge = np.abs(column) >= 2.0**62
+    if huge.any():
+        i = int(np.flatnonzero(huge)[0])
+        k = start + i if rows is None else rows[i]
+        raise InputError(f"{what} {column[i]!r} is out of range",
+                         where=src.where(k, f"{row_name} {i}"))
 
 
 def _msh4_nodes(src, start, stop):
@@ -816,10 +826,13 @@ def _msh_elements(src, section, tags, points, rows_of):
             for i, row in enumerate(rows):
                 for token in row:
                     try:
-                        int(token)
+                        value = int(token)
                     except ValueError:
                         raise InputError(f"cannot read node tag {token!r} as an integer",
                                          where=src.where(lines[i], f"{what} {i}")) from None
+                    if not -(2**63) <= value < 2**63:
+                        raise InputError(f"node tag {token} is out of range (not in $Nodes)",
+                                         where=src.where(lines[i], f"{what} {i}"))
             raise
         idx, missing = lookup(arr)
         if missing.any():
@@ -836,7 +849,7 @@ def _msh_elements(src, section, tags, points, rows_of):
     if tet_phys[size]:
         try:
             extra["region"] = np.array(tet_phys[size], dtype=np.int64)
-        except ValueError:
+        except (ValueError, OverflowError):  # physical tags we cannot hold: no regions
             pass
     if tri_rows:
         if len(set(map(len, tri_rows))) > 1:  # mixed 3- and 6-node triangles: corners only
@@ -845,7 +858,7 @@ def _msh_elements(src, section, tags, points, rows_of):
         extra["triangles"] = tri
         try:
             extra["triangle_tags"] = np.array(tri_phys, dtype=np.int64) - 1
-        except ValueError:
+        except (ValueError, OverflowError):
             pass
     return TetMesh(points, tets, extra=extra)
 
@@ -951,6 +964,11 @@ def _read_inp(path, data):
             arr = _parse_block(sub, 0, len(lines), 4, np.float64, "node", extra="forbid")
             _check_integral(sub, 0, arr[:, 0], "node id", "node")
             _check_finite_points(arr[:, 1:], lambda i, s=sub: s.where(i, f"node {i}"))
+            huge = np.abs(arr[:, 0]) >= 2.0**62
+            if huge.any():
+                i = int(np.flatnonzero(huge)[0])
+                raise InputError(f"node id {arr[i, 0]!r} is out of range",
+                                 where=sub.where(i, f"node {i}"))
             node_ids.append(arr[:, 0].astype(np.int64))
             node_xyz.append(arr[:, 1:])
         elif keyword == "ELEMENT":
@@ -972,11 +990,14 @@ def _read_inp(path, data):
             except (ValueError, OverflowError):
                 for t, token in enumerate(tokens):
                     try:
-                        int(token)
+                        value = int(token)
                     except ValueError:
                         k = _token_line(src, start, end, t)
                         raise InputError(f"cannot read {token!r} as an integer id",
                                          where=src.where(k)) from None
+                    if not -(2**63) <= value < 2**63:
+                        k = _token_line(src, start, end, t)
+                        raise InputError(f"id {token} is out of range", where=src.where(k))
                 raise
             elements[size].append((arr[:, 0], arr[:, 1:], src, start, end))
     if not node_ids:
@@ -1047,6 +1068,8 @@ def _read_tetgen_files(node_path, ele_path):
     node_data = _read_bytes(node_path)
     ele_data = _read_bytes(ele_path)
     src = _Text(node_path, _decode(node_data))
+    if not len(src):
+        raise InputError("the file holds only comments: no node header", where=node_path)
     header = src.lines[0].split()
     if len(header) < 2:
         raise InputError("expected '<nodes> <dimension> [<attributes> <markers>]'",
@@ -1078,6 +1101,8 @@ def _read_tetgen_files(node_path, ele_path):
                          where=src.where(1 + n))
 
     esrc = _Text(ele_path, _decode(ele_data))
+    if not len(esrc):
+        raise InputError("the file holds only comments: no tetrahedron header", where=ele_path)
     header = esrc.lines[0].split()
     if len(header) < 2:
         raise InputError("expected '<tetrahedra> <nodes per tet> [<attributes>]'",
@@ -1093,10 +1118,10 @@ def _read_tetgen_files(node_path, ele_path):
     earr = _parse_block(esrc, 1, m, 1 + k + eattr, np.float64, "tetrahedron",
                         extra="forbid", plural="tetrahedra")
     nodes = earr[:, 1:1 + k]
-    bad = nodes != np.round(nodes)
+    bad = (nodes != np.round(nodes)) | (np.abs(nodes) >= 2.0**62)
     if bad.any():
         i = int(np.flatnonzero(bad.any(axis=1))[0])
-        raise InputError(f"node index {nodes[i][bad[i]][0]!r} is not an integer",
+        raise InputError(f"node index {nodes[i][bad[i]][0]!r} is not an integer in range",
                          where=esrc.where(1 + i, f"tetrahedron {i}"))
     tets = nodes.astype(np.int64) - base
     _check_indices(tets, n, lambda i: esrc.where(1 + i, f"tetrahedron {i}"),
