@@ -1,7 +1,10 @@
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
-//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--write STEM]
+//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--reorient] [--write STEM]
+//
+// The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
+// shells facing the wrong way); --reorient flips triangles as that check allows.
 //
 // Exit: 0 valid mesh, 1 meshing error or invalid mesh, 2 bad input.
 #include <chrono>
@@ -13,19 +16,23 @@
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesh_io.h"
 #include "bsptet/mesher.h"
+#include "bsptet/surface_check.h"
 
 using namespace bsptet;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--write STEM]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--reorient] [--write STEM]\n",
+                 argv[0]);
     return 2;
   }
   MeshOptions o;
+  SurfaceCheckOptions check;
   std::string stem;
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
+    else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
@@ -33,7 +40,8 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    const SurfaceMesh s = read_off(argv[1]);
+    SurfaceMesh s = read_off(argv[1]);
+    s.tri = check_surface(s, check).tri;
     MeshStats st;
     const TetMesh m = tetrahedralize(s, o, &st);
     const MeshCheckReport r = check_mesh(s, m);
