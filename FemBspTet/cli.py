@@ -140,7 +140,7 @@ def _check_mesh_args(args):
         args.max_memory_bytes = default_budget()
 
 
-def _write_intersections(path, exc, quiet):
+def _write_intersections(path, exc):
     """Writes the triangles of the intersecting pairs of ``exc`` to ``path`` for viewing."""
     import numpy as np
 
@@ -182,7 +182,7 @@ def _cmd_mesh(args):
     except SelfIntersectionError as exc:
         if args.write_intersections:
             progress.finish()
-            _write_intersections(args.write_intersections, exc, args.quiet)
+            _write_intersections(args.write_intersections, exc)
         raise
     finally:
         progress.finish()

@@ -26,6 +26,54 @@ inline void kept_axes(int axis, int& u, int& v) {
   v = (axis + 2) % 3;
 }
 
+// Exactness certificates (issue 7: coplanar and collinear inputs, whose determinants are exactly
+// zero, defeat every filter; on CAD tessellations most of them are on a coarse grid where every
+// operation of the double evaluation is exact). Each helper computes one operation in doubles and
+// says whether the result is exact: a difference by Knuth's TwoSum error term (exact with
+// subnormals; no overflow allowed), a product by its fma residual (exact when the operands are far
+// from underflow or one is zero). When every operation is exact the double result is the exact
+// value, and its sign is the sign of the determinant.
+inline bool exact_diff(double a, double b, double& out) {
+  out = a - b;
+  if (!std::isfinite(out)) return false;
+  const double bb = out - a;
+  return (a - (out - bb)) + (-b - bb) == 0;
+}
+inline bool exact_prod(double a, double b, double& out) {
+  out = a * b;
+  if (a == 0 || b == 0) return true;
+  constexpr double kTiny = 0x1p-400;  // both above: the residual is a multiple of 2^-904, representable
+  if (!std::isfinite(out) || std::fabs(a) < kTiny || std::fabs(b) < kTiny) return false;
+  return std::fma(a, b, -out) == 0;
+}
+
+// sign(orient2d) when its double evaluation is exact; false otherwise.
+bool orient2d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, int u, int v, Sign& out) {
+  double bu, bv, cu, cv, l, r;
+  if (!exact_diff(b[u], a[u], bu) || !exact_diff(b[v], a[v], bv) || !exact_diff(c[u], a[u], cu) ||
+      !exact_diff(c[v], a[v], cv) || !exact_prod(bu, cv, l) || !exact_prod(bv, cu, r))
+    return false;
+  out = l > r ? Sign::kPositive : (l < r ? Sign::kNegative : Sign::kZero);  // comparing is exact
+  return true;
+}
+
+// sign(orient3d) when its double evaluation is exact; false otherwise.
+bool orient3d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
+  double bx, by, bz, cx, cy, cz, dx, dy, dz;
+  if (!exact_diff(b.x, a.x, bx) || !exact_diff(b.y, a.y, by) || !exact_diff(b.z, a.z, bz) ||
+      !exact_diff(c.x, a.x, cx) || !exact_diff(c.y, a.y, cy) || !exact_diff(c.z, a.z, cz) ||
+      !exact_diff(d.x, a.x, dx) || !exact_diff(d.y, a.y, dy) || !exact_diff(d.z, a.z, dz))
+    return false;
+  double m1, m2, m3, m4, m5, m6, n1, n2, n3, t1, t2, t3, s12, det;
+  if (!exact_prod(cy, dz, m1) || !exact_prod(cz, dy, m2) || !exact_prod(cx, dz, m3) || !exact_prod(cz, dx, m4) ||
+      !exact_prod(cx, dy, m5) || !exact_prod(cy, dx, m6) || !exact_diff(m1, m2, n1) || !exact_diff(m3, m4, n2) ||
+      !exact_diff(m5, m6, n3) || !exact_prod(bx, n1, t1) || !exact_prod(by, n2, t2) || !exact_prod(bz, n3, t3) ||
+      !exact_diff(t1, t2, s12) || !exact_diff(s12, -t3, det))
+    return false;
+  out = sign_of(det);
+  return true;
+}
+
 }  // namespace
 
 Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
@@ -49,6 +97,8 @@ Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
                       std::fabs(bz) * (std::fabs(m5) + std::fabs(m6));
   const double bound = kOrient3dBound * perm;
   if (std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > bound) return sign_of(det);
+  Sign certified;
+  if (orient3d_exact_in_doubles(a, b, c, d, certified)) return certified;
   return orient3d_exact(a, b, c, d);
 }
 
@@ -70,6 +120,8 @@ Sign orient2d_projected(const Vec3& a, const Vec3& b, const Vec3& c, int axis) {
   const double perm = std::fabs(l) + std::fabs(r);
   if (std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > kOrient2dBound * perm)
     return sign_of(det);
+  Sign certified;
+  if (orient2d_exact_in_doubles(a, b, c, u, v, certified)) return certified;
   return orient2d_projected_exact(a, b, c, axis);
 }
 

@@ -7,6 +7,7 @@
 
 #include "bsptet/errors.h"
 #include "bsptet/mesh_io.h"
+#include "bsptet/predicates.h"
 #include "bsptet/self_intersection.h"
 #include "bsptet/surface_check.h"
 #include "bsptet/triangle_intersection.h"
@@ -253,4 +254,30 @@ TEST(MeshIoFuzzRegressions, LyingCountsDoNotExhaustMemory) {
   EXPECT_THROW(parse_tetgen("3 3 9223372036854775807 0\n", "0 4 0\n", "a.node", "a.ele"), InputError);
   EXPECT_THROW(parse_tetgen("1 3 0 0\n1 0 0 0\n", "1 4 0\n1 -9223372036854775808 1 1 1\n", "a.node", "a.ele"),
                InputError);
+}
+
+// The exactness certificates in predicates.cpp (taken when the filter cannot decide) must agree
+// with the exact evaluation: grid points (many exact zeros), scaled far up and down, and points
+// one ulp off the grid (where the certificate must refuse and fall back).
+TEST(PredicateCertificates, AgreeWithExactOnGridsAndNearThem) {
+  std::uint64_t state = 12345;
+  auto next = [&]() {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<int>((state >> 33) % 7) - 3;
+  };
+  const double scales[] = {1.0, 0.5, 0x1p-30, 0x1p40, 0x1p-390, 0x1p-420, 1e300};
+  int zeros = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double s = scales[trial % 7];
+    Vec3 p[4];
+    for (auto& q : p) q = {next() * s, next() * s, next() * s};
+    if (trial % 5 == 0) p[3] = Vec3{std::nextafter(p[3].x, 1e308), p[3].y, p[3].z};
+    if (trial % 11 == 0) p[2] = Vec3{p[0].x + 1e6 * s, p[0].y, p[0].z};
+    const Sign fast = orient3d(p[0], p[1], p[2], p[3]), exact = orient3d_exact(p[0], p[1], p[2], p[3]);
+    ASSERT_EQ(fast, exact) << trial;
+    zeros += exact == Sign::kZero;
+    for (int axis = 0; axis < 3; ++axis)
+      ASSERT_EQ(orient2d_projected(p[0], p[1], p[3], axis), orient2d_projected_exact(p[0], p[1], p[3], axis)) << trial;
+  }
+  EXPECT_GT(zeros, 1000);  // the test does exercise exact zeros
 }
