@@ -481,3 +481,18 @@ def test_pinned_python_fuzz_findings(name):
             reader(path)
         except InputError:
             pass
+
+
+def test_internal_error_of_the_core_is_reported_cleanly(cli, tmp_path):
+    """plate_holes ends in the core's internal error for now (issue 3): exit 1, a message that says
+    it is our fault, nothing written. Once the core meshes it, the mesh must be valid instead."""
+    out = tmp_path / "plate.vtu"
+    r = run_cli(cli, "mesh", corpus_path("plate_holes"), "-o", out, "--quiet")
+    if r.returncode == 0:
+        check = run_cli(cli, "check", corpus_path("plate_holes"), out)
+        assert check.returncode == 0, check.stdout
+        return
+    assert r.returncode == 1, r.stderr
+    assert "the mesher failed" in r.stderr and "please report it" in r.stderr
+    assert "plate_holes.off" in r.stderr and "Traceback" not in r.stderr
+    assert os.listdir(tmp_path) == []
