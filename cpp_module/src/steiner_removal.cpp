@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -588,6 +589,73 @@ class TetComplex {
     return true;
   }
 
+  /// EDGE REMOVAL (an n-to-2(n-2) flip): the n tets around the interior edge (v, x) are replaced by
+  /// the cones from x and from v over a triangulation of their ring polygon a_0..a_{n-1} (oriented
+  /// so that every (v, x, a_i, a_i+1) is positive): tets (p, q, r, x) and (p, r, q, v) for each
+  /// triangle (p, q, r) in ring order. The outer faces (v or x, a_i, a_i+1) are kept, so the result
+  /// is conforming; it is taken when every new tet is positive (the first triangulation found, in
+  /// a fixed order). n <= 7. Returns false, changing nothing, otherwise.
+  bool remove_edge(Index v, Index x) {
+    std::vector<Index> around;
+    for (Index id : vt_[v]) {
+      const auto& t = tets_[id];
+      if (std::find(t.begin(), t.end(), x) != t.end()) around.push_back(id);
+    }
+    const std::size_t n = around.size();
+    if (n < 3 || n > 7) return false;
+    std::map<Index, Index> next;
+    for (Index id : around) {
+      const std::array<Index, 4>& t = tets_[id];
+      // The other two, p and q, ordered so that (v, x, p, q) is an even permutation of the stored
+      // (positive) tet.
+      int pos[4], k = 2;
+      Index pq[2] = {-1, -1};
+      for (int i = 0; i < 4; ++i) {
+        if (t[i] == v) pos[0] = i;
+        else if (t[i] == x) pos[1] = i;
+        else pq[k - 2] = t[i], pos[k++] = i;
+      }
+      int inversions = 0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) inversions += pos[i] > pos[j];
+      if (inversions % 2) std::swap(pq[0], pq[1]);
+      if (next.count(pq[0])) return false;
+      next[pq[0]] = pq[1];
+    }
+    std::vector<Index> ring{next.begin()->first};
+    while (ring.size() < n) {
+      auto it = next.find(ring.back());
+      if (it == next.end()) return false;
+      ring.push_back(it->second);
+    }
+    if (next[ring.back()] != ring[0]) return false;
+    // Triangulations of the ring polygon, enumerated recursively (fan-first order).
+    std::vector<std::array<Index, 4>> repl;
+    std::function<bool(std::vector<Index>)> solve = [&](std::vector<Index> poly) -> bool {
+      const std::size_t m = poly.size();
+      if (m < 3) return true;
+      // The triangle on edge (poly[0], poly[m-1]) with apex poly[k].
+      for (std::size_t k = 1; k + 1 < m; ++k) {
+        const Index p = poly[0], q = poly[k], r = poly[m - 1];
+        if (geo_.orient3d(p, q, r, x) != Sign::kPositive || geo_.orient3d(p, r, q, v) != Sign::kPositive) continue;
+        const std::size_t mark = repl.size();
+        repl.push_back({p, q, r, x});
+        repl.push_back({p, r, q, v});
+        if (solve(std::vector<Index>(poly.begin(), poly.begin() + static_cast<std::ptrdiff_t>(k + 1))) &&
+            solve(std::vector<Index>(poly.begin() + static_cast<std::ptrdiff_t>(k), poly.end())))
+          return true;
+        repl.resize(mark);
+      }
+      return false;
+    };
+    if (!solve(ring)) return false;
+    std::sort(around.begin(), around.end());
+    if (!tets_are_new(repl, around)) return false;
+    for (Index id : around) kill_tet(id);
+    for (const auto& t : repl) add_tet(t);
+    return true;
+  }
+
   /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
   std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
     std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
@@ -834,6 +902,56 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     st.collapsed += removed;
     if (removed == 0 && mesh.merged == merged_before) break;
     collapse_passes(0.9, 0.95);
+  }
+  // Those left: lower their degree by edge removals (each one takes a neighbour away from v), and
+  // collapse or re-cone after each one.
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    bool gone = false;
+    for (int flips = 0; flips < 64 && !gone; ++flips) {
+      std::vector<std::pair<std::size_t, Index>> by_ring;
+      for (Index x : mesh.neighbours(v)) {
+        std::size_t ring = 0;
+        for (Index id : mesh.star(v)) {
+          const auto& t = mesh.tet(id);
+          ring += std::find(t.begin(), t.end(), x) != t.end();
+        }
+        by_ring.push_back({ring, x});
+      }
+      std::sort(by_ring.begin(), by_ring.end());
+      bool flipped = false;
+      for (const auto& [ring, x] : by_ring)
+        if ((flipped = mesh.remove_edge(v, x))) break;
+      if (!flipped) break;
+      ++st.flips;
+      for (Index u : mesh.neighbours(v))
+        if (mesh.try_substitute(v, u) || mesh.cone_from_vertex(v, u, 6, 400)) {
+          gone = true;
+          ++st.collapsed;
+          break;
+        }
+    }
+  }
+  // The few left: cones from farther vertices (the nearest 48, input points among them first
+  // when equally near) over cavities grown further.
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    const Vec3 pv = geo.rounded(v);
+    std::vector<std::pair<double, Index>> near;
+    for (Index u = 0; u < geo.num_vertices(); ++u) {
+      if (u == v || !mesh.used(u)) continue;
+      const Vec3 q = geo.rounded(u);
+      near.push_back({(q.x - pv.x) * (q.x - pv.x) + (q.y - pv.y) * (q.y - pv.y) + (q.z - pv.z) * (q.z - pv.z), u});
+    }
+    const std::size_t k = std::min<std::size_t>(48, near.size());
+    std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
+    for (std::size_t i = 0; i < k; ++i)
+      if (mesh.cone_from_vertex(v, near[i].second, 24, 2000)) {
+        ++st.collapsed;
+        break;
+      }
   }
 
   // Round the implicit points left.
