@@ -3,7 +3,8 @@
 A writer opens :func:`atomic_output` (or :func:`atomic_outputs` for formats made of several
 files, such as TetGen's ``.node`` + ``.ele``) and writes into the object it yields. The data
 go to a temporary file in the *same directory* as the target, named
-``.<target name>.<random>.tmp``. On a normal exit the temporary file is flushed, ``fsync``-ed
+``.<target name>.<pid>.<random>.tmp`` (the process id lets a supervising process find and remove
+the temporary files of a worker it had to stop: :mod:`FemBspTet.supervisor`). On a normal exit the temporary file is flushed, ``fsync``-ed
 and renamed onto the target with :func:`os.replace`, which is atomic on POSIX file systems.
 On any exception inside the ``with`` block the temporary file is deleted, the exception
 propagates unchanged and the target is untouched: a previous file of that name survives.
@@ -81,7 +82,7 @@ def _open_temporary(path, mode):
     if os.path.isdir(path):
         raise InputError("cannot write the file: a directory of that name exists", where=path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix="." + name + ".", suffix=".tmp", dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.{os.getpid()}.", suffix=".tmp", dir=directory)
     except FileNotFoundError:
         raise InputError(f"cannot write the file: directory {directory!r} does not exist",
                          where=path) from None

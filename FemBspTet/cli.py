@@ -1,23 +1,28 @@
 """The ``fembsptet`` command line.
 
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--order 1|2] [--stats-json FILE]
-                   [--quiet]
+                   [--quiet] [--reorient] [--write-intersections FILE] [--max-memory SIZE]
+                   [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
 
 Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
-mesh is not valid; 1 internal failure; 130 interrupted.
+mesh is not valid, and for a run over its memory budget; 1 internal failure (also a crash of the
+native code); 124 time limit reached (--timeout); 130 interrupted (Ctrl-C, SIGTERM).
+``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.supervisor`): Ctrl-C,
+--timeout and the memory budget stop it within a fraction of a second, with no partial file.
 Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli``.
 """
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
 import traceback
 
 from . import __version__
-from .errors import BspTetError, InputError
+from .errors import BspTetError, InputError, SelfIntersectionError
 from .progress import Progress
 
 SURFACE_EXTENSIONS = (".off", ".stl", ".obj", ".ply")
@@ -110,13 +115,56 @@ def read_volume(path):
     )
 
 
+def _check_mesh_args(args):
+    """Option checks done before any work (and before the supervised child starts)."""
+    for out in args.output:
+        check_output_path(out)
+    if args.size is not None and not (args.size > 0 and math.isfinite(args.size)):
+        raise InputError(f"--size must be a positive length, got {args.size}")
+    if args.timeout is not None and not (args.timeout > 0 and math.isfinite(args.timeout)):
+        raise InputError(f"--timeout must be a positive number of seconds, got {args.timeout}")
+    if args.write_intersections is not None:
+        ext = _ext(args.write_intersections)
+        if ext not in SURFACE_EXTENSIONS:
+            raise InputError(
+                f"unknown format '{ext or '(no extension)'}' for --write-intersections; supported: "
+                + ", ".join(SURFACE_EXTENSIONS), where=args.write_intersections)
+        parent = os.path.dirname(os.path.abspath(args.write_intersections))
+        if not os.path.isdir(parent):
+            raise InputError("the output directory does not exist", where=parent)
+    from .memory_budget import default_budget, parse_size
+
+    if args.max_memory is not None:
+        args.max_memory_bytes = parse_size(args.max_memory, option="--max-memory")
+    else:
+        args.max_memory_bytes = default_budget()
+
+
+def _write_intersections(path, exc, quiet):
+    """Writes the triangles of the intersecting pairs of ``exc`` to ``path`` for viewing."""
+    import numpy as np
+
+    from .mesh_types import Surface
+    from .surface_io import write_surface
+
+    surface = exc.surface
+    pairs = np.asarray(exc.pairs, dtype=np.int64).reshape(-1, 2)
+    involved = np.unique(pairs)
+    used = np.unique(surface.triangles[involved])
+    remap = np.full(len(surface.points), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    # Face tags are the input's triangle indices: a viewer can colour or pick them by number.
+    out = Surface(surface.points[used], remap[surface.triangles[involved]], involved.astype(np.int32))
+    write_surface(path, out)
+    print(f"fembsptet: wrote the {len(involved)} triangles of {len(pairs)} intersecting pair(s) to "
+          f"{path} (face tags = triangle indices)", file=sys.stderr)
+
+
 def _cmd_mesh(args):
     progress = Progress(enabled=not args.quiet)
     t0 = time.perf_counter()
-    for out in args.output:
-        check_output_path(out)
-    if args.size is not None and not (args.size > 0):
-        raise InputError(f"--size must be a positive length, got {args.size}")
+    if not hasattr(args, "max_memory_bytes"):
+        _check_mesh_args(args)
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
     from . import core
@@ -127,8 +175,15 @@ def _cmd_mesh(args):
             surfaces,
             options={"size": args.size if _ext(args.input) in SURFACE_EXTENSIONS else None,
                      "order": args.order,
-                     "allow_boundary_steiner": args.allow_boundary_steiner},
+                     "allow_boundary_steiner": args.allow_boundary_steiner,
+                     "reorient": args.reorient,
+                     "max_memory": args.max_memory_bytes},
             progress=progress)
+    except SelfIntersectionError as exc:
+        if args.write_intersections:
+            progress.finish()
+            _write_intersections(args.write_intersections, exc, args.quiet)
+        raise
     finally:
         progress.finish()
     progress("writing")
@@ -259,6 +314,18 @@ def build_parser():
                         "(default: none on the surface, as tetgen -Y)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
+    m.add_argument("--reorient", action="store_true",
+                   help="flip inconsistently oriented triangles and inward-facing shells instead of "
+                        "refusing the surface (cavities are made to face inward)")
+    m.add_argument("--write-intersections", metavar="FILE", default=None,
+                   help="if the surface intersects itself, write the intersecting triangles here "
+                        "(.off .stl .obj .ply; face tags = triangle indices) for viewing")
+    m.add_argument("--max-memory", metavar="SIZE", default=None,
+                   help="memory budget, e.g. 4G or 512M (default: the memory available now); a "
+                        "run estimated to need more is refused before it starts, one that uses "
+                        "more is stopped (exit 2)")
+    m.add_argument("--timeout", metavar="SECONDS", type=float, default=None,
+                   help="stop the run after this many seconds (exit 124; no output is written)")
     m.set_defaults(func=_cmd_mesh)
 
     c = sub.add_parser("check", help="check a tet mesh against its surface (exit 0 only if valid)")
@@ -270,10 +337,10 @@ def build_parser():
     return p
 
 
-def main(argv=None):
-    args = build_parser().parse_args(argv)
+def _run_reporting(func, args):
+    """Runs ``func(args)``; every error becomes one message on stderr and an exit code."""
     try:
-        return args.func(args)
+        return func(args)
     except InputError as exc:
         print(f"fembsptet: error: {exc}", file=sys.stderr)
         return 2
@@ -283,10 +350,42 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("fembsptet: interrupted; no output was written", file=sys.stderr)
         return 130
+    except MemoryError:
+        print("fembsptet: error: out of memory; no output was written (set a --max-memory budget "
+              "or mesh a coarser tessellation)", file=sys.stderr)
+        return 2
     except Exception:  # noqa: BLE001 - last resort: report and exit 1, never a bare traceback
         print("fembsptet: internal error (please report it with the input):", file=sys.stderr)
         traceback.print_exc()
         return 1
+
+
+def _supervised_mesh(args):
+    """``mesh`` in a supervised child process (timeout, Ctrl-C, memory, crashes: supervisor.py)."""
+    from .supervisor import Limits, run_supervised
+
+    _check_mesh_args(args)
+    outputs = list(args.output)
+    for extra in (args.stats_json, args.write_intersections):
+        if extra:
+            outputs.append(extra)
+    for out in args.output:  # TetGen output is two files
+        if _ext(out) in (".node", ".ele"):
+            outputs += [os.path.splitext(out)[0] + ".node", os.path.splitext(out)[0] + ".ele"]
+    limits = Limits(timeout=args.timeout, max_memory=args.max_memory_bytes)
+    return run_supervised(lambda: _run_reporting(_cmd_mesh, args), limits, outputs)
+
+
+def main(argv=None, supervise=True):
+    """The command line. ``supervise=False`` runs ``mesh`` in this process (no --timeout, no
+    memory watch, no crash isolation; for callers that supervise it themselves)."""
+    args = build_parser().parse_args(argv)
+    if args.command == "mesh" and supervise:
+        return _run_reporting(_supervised_mesh, args)
+    if args.command == "mesh" and args.timeout is not None:
+        print("fembsptet: error: --timeout needs the supervised run", file=sys.stderr)
+        return 2
+    return _run_reporting(args.func, args)
 
 
 if __name__ == "__main__":

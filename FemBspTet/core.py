@@ -15,7 +15,7 @@ conditions are listed in ``cpp_module/include/bsptet/mesh_check.h``.
 
 import numpy as np
 
-from .errors import InternalError
+from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
 from .mesh_types import Surface, TetMesh
 
 
@@ -41,6 +41,38 @@ def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_
         max_messages=max_messages,
         compute_quality=compute_quality,
     )
+
+
+def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000):
+    """Checks that ``surface`` bounds a solid the mesher can fill, exactly, before any meshing.
+
+    The checks and their order are in ``cpp_module/include/bsptet/surface_check.h``: finite
+    coordinates, indices, degenerate and duplicate triangles, open and non-manifold edges,
+    consistent orientation, non-manifold vertices, self-intersections, shells facing the right
+    way (outer shells outward, cavities inward). ``reorient=True`` flips triangles to make the
+    orientation consistent and the shells face the right way instead of refusing.
+
+    Returns ``(surface, info)``: the surface with flipped triangles reversed (the same object
+    when nothing was flipped) and ``info`` (``flipped_triangles``, ``shells``,
+    ``merged_points``). Raises :class:`InputError` (``code`` names the kind of problem; the
+    message names the triangle, edge or vertex), :class:`SelfIntersectionError` with the pairs.
+    """
+    native = _native()
+    where = surface.source or None
+    try:
+        tri, info = native.check_surface(surface.points, surface.triangles, reorient=bool(reorient),
+                                         max_reported_pairs=int(max_reported_pairs))
+    except native.InputError as exc:
+        if getattr(exc, "code", "") == "self_intersection":
+            raise SelfIntersectionError(str(exc), where=where, pairs=np.asarray(exc.pairs),
+                                        complete=bool(exc.complete), surface=surface) from None
+        raise InputError(str(exc), where=where, code=getattr(exc, "code", None)) from None
+    except ValueError as exc:  # array shapes or indices beyond 32 bits (the binding's checks)
+        raise InputError(str(exc), where=where, code="bad_argument") from None
+    info = dict(info)
+    if info["flipped_triangles"]:
+        surface = Surface(surface.points, tri, surface.face_tags, surface.source)
+    return surface, info
 
 
 def tet_quality(mesh: TetMesh):
@@ -82,9 +114,12 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
 
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``order`` (1 or 2),
     ``size`` (maximum edge length: used for the tessellation of CAD input; volume sizing is not
-    built yet and is reported in ``stats["notes"]``).
+    built yet and is reported in ``stats["notes"]``), ``reorient`` (bool, default False: flip
+    inconsistently oriented or inward-facing shells instead of refusing them, see
+    :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before meshing, a run whose
+    estimated peak memory exceeds it, :class:`MemoryBudgetError`; see :mod:`memory_budget`).
     ``progress(stage, fraction)`` is called now and then; ``cancel()`` returning True stops the run
-    (``InternalError``); Ctrl-C raises ``KeyboardInterrupt``.
+    (:class:`Cancelled`); Ctrl-C raises ``KeyboardInterrupt``.
 
     Returns ``(TetMesh, stats)``. Every mesh is checked exactly against its surface before it is
     returned; ``stats`` holds the core's figures (see ``cli.STATS_KEYS``) and the checker's quality.
@@ -93,7 +128,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     from .errors import InputError
 
     options = dict(options or {})
-    unknown = set(options) - {"allow_boundary_steiner", "order", "size"}
+    unknown = set(options) - {"allow_boundary_steiner", "order", "size", "reorient", "max_memory"}
     if unknown:
         raise InputError(f"unknown mesher option(s): {', '.join(sorted(unknown))}")
     order = int(options.get("order") or 1)
@@ -102,6 +137,16 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
     native = _native()
+    checked, flipped = [], 0
+    for surface in surfaces:
+        surface, info = check_surface(surface, reorient=bool(options.get("reorient", False)))
+        checked.append(surface)
+        flipped += info["flipped_triangles"]
+    surfaces = checked
+    if options.get("max_memory") is not None:
+        from .memory_budget import require_within_budget
+
+        require_within_budget(surfaces, int(options["max_memory"]))
     meshes, all_stats = [], []
     for k, surface in enumerate(surfaces):
         label = f"solid {k + 1} of {len(surfaces)}: " if len(surfaces) > 1 else ""
@@ -119,7 +164,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             raise InputError(str(exc), where=surface.source or None) from None
         except native.MeshingError as exc:
             if getattr(exc, "code", "") == "cancelled":
-                raise InternalError("cancelled: no mesh was made") from None
+                raise Cancelled("cancelled: no mesh was made") from None
             raise InternalError(
                 f"{surface.source or 'surface'}: the mesher failed ({exc}); this is a bug, "
                 "please report it with the input") from None
@@ -139,7 +184,10 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     stats["order"] = order
     stats["nodes"] = int(len(mesh.points))
     stats["valid"] = True
+    stats["flipped_triangles"] = flipped
     notes = []
+    if flipped:
+        notes.append(f"re-oriented {flipped} triangle(s) (--reorient)")
     if options.get("size") is not None:
         notes.append("volume size control is not built yet: tets use the surface's vertices only")
     stats["notes"] = notes

@@ -4,7 +4,10 @@ Every error names what is wrong and where (file, line, triangle or vertex index,
 where it can, what to do about it. The CLI maps them to exit codes:
 
 * :class:`InputError`    -> exit code 2 (the input is bad; the user can fix it)
+  (:class:`SelfIntersectionError` and :class:`MemoryBudgetError` are kinds of it)
 * :class:`InternalError` -> exit code 1 (our fault, or a feature that does not exist yet)
+* :class:`Cancelled`     -> exit code 130 (Ctrl-C, the task panel's Cancel, a ``cancel()`` callback)
+* :class:`TimeLimitReached` -> exit code 124 (``--timeout``; the same code as coreutils' timeout)
 """
 
 
@@ -19,16 +22,52 @@ class InputError(BspTetError, ValueError):
 
     exit_code = 2
 
-    def __init__(self, message, where=None):
+    def __init__(self, message, where=None, code=None):
         self.where = where
+        #: The core's snake_case error code ("open_boundary", "self_intersection", ...) or None.
+        self.code = code
         text = f"{where}: {message}" if where else message
         super().__init__(text)
+
+
+class SelfIntersectionError(InputError):
+    """The surface crosses or touches itself. ``pairs`` is an (k, 2) int array of intersecting
+    triangle indices (sorted, first < second); ``complete`` is False when there were more than
+    were collected. ``surface`` is the surface they index into."""
+
+    def __init__(self, message, where=None, pairs=None, complete=True, surface=None):
+        super().__init__(message, where=where, code="self_intersection")
+        self.pairs = pairs
+        self.complete = complete
+        self.surface = surface
+
+
+class MemoryBudgetError(InputError):
+    """The run would need (estimated before it starts) or needed more memory than the budget
+    (``--max-memory``). ``estimate`` and ``budget`` are in bytes."""
+
+    def __init__(self, message, where=None, estimate=None, budget=None):
+        super().__init__(message, where=where, code="memory_budget")
+        self.estimate = estimate
+        self.budget = budget
 
 
 class InternalError(BspTetError, RuntimeError):
     """Something failed that is not the user's fault; please report it with the input."""
 
     exit_code = 1
+
+
+class Cancelled(BspTetError):
+    """The run was stopped on request (Ctrl-C, Cancel); nothing was written."""
+
+    exit_code = 130
+
+
+class TimeLimitReached(Cancelled):
+    """The run was stopped because its time limit (``--timeout``) was reached; nothing was written."""
+
+    exit_code = 124
 
 
 class NotImplementedYetError(InternalError):

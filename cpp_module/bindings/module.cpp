@@ -10,6 +10,7 @@
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesher.h"
 #include "bsptet/predicates.h"
+#include "bsptet/surface_check.h"
 
 namespace py = pybind11;
 using namespace bsptet;
@@ -156,6 +157,51 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError.");
+
+  // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
+  // with `pairs` (k, 2) and `complete` besides `code` and `index`.
+  m.def(
+      "check_surface",
+      [](const DoubleArray& points, const IndexArray& triangles, bool reorient, bool self_intersections,
+         std::int64_t max_reported_pairs) {
+        SurfaceMesh s;
+        s.xyz = points_from(points, "points");
+        s.tri = indices_from(triangles, "triangles", 3);
+        SurfaceCheckOptions o;
+        o.reorient = reorient;
+        o.self_intersections = self_intersections;
+        o.max_reported_pairs = max_reported_pairs;
+        SurfaceCheckResult r;
+        try {
+          py::gil_scoped_release release;
+          r = check_surface(s, o);
+        } catch (const SelfIntersectionError& e) {
+          py::array_t<std::int64_t> pairs({static_cast<py::ssize_t>(e.pairs().size()), static_cast<py::ssize_t>(2)});
+          auto out = pairs.mutable_unchecked<2>();
+          for (std::size_t i = 0; i < e.pairs().size(); ++i) {
+            out(static_cast<py::ssize_t>(i), 0) = e.pairs()[i][0];
+            out(static_cast<py::ssize_t>(i), 1) = e.pairs()[i][1];
+          }
+          py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
+          exc.attr("code") = error_code_name(e.code());
+          exc.attr("index") = e.index();
+          exc.attr("pairs") = pairs;
+          exc.attr("complete") = e.complete();
+          PyErr_SetObject(input_error.ptr(), exc.ptr());
+          throw py::error_already_set();
+        }
+        py::array_t<std::int64_t> tri({static_cast<py::ssize_t>(r.tri.size() / 3), static_cast<py::ssize_t>(3)});
+        std::copy(r.tri.begin(), r.tri.end(), tri.mutable_data());
+        py::dict d;
+        d["flipped_triangles"] = r.flipped_triangles;
+        d["shells"] = r.shells;
+        d["merged_points"] = r.merged_points;
+        return py::make_tuple(tri, d);
+      },
+      py::arg("points"), py::arg("triangles"), py::arg("reorient") = false, py::arg("self_intersections") = true,
+      py::arg("max_reported_pairs") = 1000,
+      "Checks a triangle surface before meshing (see surface_check.h). Returns (triangles (m, 3) with "
+      "flipped ones reversed, info dict). Raises InputError naming the first problem.");
 
   m.def(
       "orient3d",

@@ -1,6 +1,9 @@
 #include "bsptet/mesh_io.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -94,10 +97,12 @@ SurfaceMesh parse_off(const std::string& text, const std::string& name) {
   tk.integer("the edge count");
   if (nv < 0 || nf < 0 || nv > INT32_MAX || nf > INT32_MAX) tk.fail("invalid vertex or face count");
   SurfaceMesh s;
-  s.xyz.reserve(static_cast<std::size_t>(nv) * 3);
+  // The counts come from the file: reserve no more than its text can hold (a vertex takes at least
+  // three numbers of two characters each), so a lying header cannot exhaust memory.
+  s.xyz.reserve(std::min(static_cast<std::size_t>(nv) * 3, text.size() / 2));
   for (long long i = 0; i < nv; ++i)
     for (int k = 0; k < 3; ++k) s.xyz.push_back(tk.real("a vertex coordinate"));
-  s.tri.reserve(static_cast<std::size_t>(nf) * 3);
+  s.tri.reserve(std::min(static_cast<std::size_t>(nf) * 3, text.size() / 2));
   for (long long f = 0; f < nf; ++f) {
     const long long n = tk.integer("a face size");
     if (n != 3) tk.fail("face " + std::to_string(f) + " has " + std::to_string(n) + " vertices; only triangles are supported");
@@ -125,27 +130,30 @@ void write_off(const std::string& path, const SurfaceMesh& s) {
     out << "3 " << s.tri[3 * t] << ' ' << s.tri[3 * t + 1] << ' ' << s.tri[3 * t + 2] << '\n';
 }
 
-TetMesh read_tetgen(const std::string& stem) {
-  const std::string node_path = stem + ".node", ele_path = stem + ".ele";
-  const std::string node_text = slurp(node_path);
-  Tokens tn(node_text, node_path);
+TetMesh parse_tetgen(const std::string& node_text, const std::string& ele_text, const std::string& node_name,
+                     const std::string& ele_name) {
+  Tokens tn(node_text, node_name);
   const long long np = tn.integer("the point count");
   if (tn.integer("the dimension") != 3) tn.fail("only 3D .node files are supported");
   const long long nattr = tn.integer("the attribute count"), nmark = tn.integer("the marker count");
+  if (np < 0 || np > INT32_MAX) tn.fail("invalid point count " + std::to_string(np));
+  if (nattr < 0 || nattr > INT32_MAX || nmark < 0 || nmark > 1) tn.fail("invalid attribute or marker count");
   TetMesh m;
   long long base = 0;
   for (long long i = 0; i < np; ++i) {
     const long long id = tn.integer("a point index");
     if (i == 0) base = id;
+    if (i == 0 && id != 0 && id != 1) tn.fail("the first point index must be 0 or 1, found " + std::to_string(id));
     if (id != base + i) tn.fail("point indices must be consecutive, found " + std::to_string(id));
     for (int k = 0; k < 3; ++k) m.xyz.push_back(tn.real("a coordinate"));
     for (long long a = 0; a < nattr + nmark; ++a) tn.need("an attribute");
   }
-  const std::string ele_text = slurp(ele_path);
-  Tokens te(ele_text, ele_path);
+  Tokens te(ele_text, ele_name);
   const long long nk = te.integer("the tet count"), npt = te.integer("the nodes per tet");
+  if (nk < 0 || nk > INT32_MAX) te.fail("invalid tet count " + std::to_string(nk));
   if (npt != 4 && npt != 10) te.fail("tets must have 4 or 10 nodes");
   const long long eattr = te.integer("the attribute count");
+  if (eattr < 0 || eattr > INT32_MAX) te.fail("invalid attribute count " + std::to_string(eattr));
   m.nodes_per_tet = static_cast<int>(npt);
   // TetGen -o2 orders mid-nodes (m34 m14 m12 m23 m24 m13); ours: m12 m23 m31 m14 m24 m34.
   const int from_tetgen[6] = {2, 3, 5, 1, 4, 0};
@@ -153,10 +161,10 @@ TetMesh read_tetgen(const std::string& stem) {
     te.integer("a tet index");
     Index v[10];
     for (long long k = 0; k < npt; ++k) {
-      const long long id = te.integer("a point index") - base;
-      if (id < 0 || id >= np)
-        te.fail("tet " + std::to_string(t) + " refers to point " + std::to_string(id + base) + ", out of range");
-      v[k] = static_cast<Index>(id);
+      const long long raw = te.integer("a point index");
+      if (raw < base || raw - base >= np)
+        te.fail("tet " + std::to_string(t) + " refers to point " + std::to_string(raw) + ", out of range");
+      v[k] = static_cast<Index>(raw - base);
     }
     for (int k = 0; k < 4; ++k) m.tet.push_back(v[k]);
     if (npt == 10)
@@ -164,6 +172,11 @@ TetMesh read_tetgen(const std::string& stem) {
     for (long long a = 0; a < eattr; ++a) te.need("an attribute");
   }
   return m;
+}
+
+TetMesh read_tetgen(const std::string& stem) {
+  const std::string node_path = stem + ".node", ele_path = stem + ".ele";
+  return parse_tetgen(slurp(node_path), slurp(ele_path), node_path, ele_path);
 }
 
 void write_tetgen(const std::string& stem, const TetMesh& m) {

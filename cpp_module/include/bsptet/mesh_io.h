@@ -18,6 +18,9 @@ void write_off(const std::string& path, const SurfaceMesh& surface);
 
 /// Reads TetGen's `stem.node` + `stem.ele` (index base 0 or 1, as the .node file says).
 TetMesh read_tetgen(const std::string& stem);
+/// Parses the texts of a `.node` and an `.ele` file (names used in messages). Throws InputError.
+TetMesh parse_tetgen(const std::string& node_text, const std::string& ele_text, const std::string& node_name,
+                     const std::string& ele_name);
 /// Writes `stem.node` + `stem.ele` (1-based), round-trip precision.
 void write_tetgen(const std::string& stem, const TetMesh& mesh);
 

@@ -1,0 +1,88 @@
+"""Memory budget of a meshing run: an estimate before it starts, sizes as people write them.
+
+    from FemBspTet.memory_budget import estimate_peak_bytes, parse_size, require_within_budget
+    budget = parse_size("4G")                         # 4 * 2**30 bytes
+    require_within_budget(surfaces, budget)           # MemoryBudgetError if the estimate exceeds it
+
+The estimate is an upper envelope measured on the corpus and the paper models (peak resident
+memory of ``bsptet_mesh`` against the triangle count, ``docs/bad-input.md``), times a safety
+factor. The BSP's size depends on the geometry, not only on the counts, so it is an estimate: the
+supervised CLI also watches the run's real resident memory against the same budget
+(:mod:`FemBspTet.supervisor`) and stops it if it goes over.
+"""
+
+import math
+import re
+
+from .errors import InputError, MemoryBudgetError
+
+__all__ = ["estimate_peak_bytes", "parse_size", "default_budget", "require_within_budget",
+           "format_bytes"]
+
+#: Fixed cost of a run: the Python interpreter, numpy, the core's tables (bytes).
+BASE_BYTES = 96 << 20
+#: Measured peak per input triangle, upper envelope (bytes); see docs/bad-input.md.
+BYTES_PER_TRIANGLE = 80 << 10
+#: The envelope grows like n log n on the corpus; normalised at 1000 triangles.
+_LOG_REFERENCE = math.log2(1000)
+
+_UNITS = {"": 1, "b": 1, "k": 1 << 10, "kb": 1 << 10, "kib": 1 << 10, "m": 1 << 20, "mb": 1 << 20,
+          "mib": 1 << 20, "g": 1 << 30, "gb": 1 << 30, "gib": 1 << 30, "t": 1 << 40, "tb": 1 << 40,
+          "tib": 1 << 40}
+
+
+def estimate_peak_bytes(n_points, n_triangles):
+    """Estimated peak memory (bytes) of meshing a surface of ``n_triangles`` triangles."""
+    n = max(int(n_triangles), 1)
+    growth = max(1.0, math.log2(max(n, 2)) / _LOG_REFERENCE)
+    return int(BASE_BYTES + BYTES_PER_TRIANGLE * n * growth + 64 * max(int(n_points), 0))
+
+
+def format_bytes(n):
+    """``1536`` -> ``"1.5 KiB"``."""
+    n = float(n)
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if abs(n) < 1024 or unit == "TiB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024.0
+    return f"{n:.1f} TiB"  # pragma: no cover
+
+
+def parse_size(text, option="size"):
+    """``"4G"``, ``"512M"``, ``"1.5GiB"``, ``"1000000"`` -> bytes (binary units). InputError if not."""
+    match = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*([A-Za-z]*)\s*", str(text))
+    if not match or match.group(2).lower() not in _UNITS:
+        raise InputError(f"{option}: cannot read {text!r} as a size; write e.g. 4G, 512M or 2GiB")
+    value = float(match.group(1)) * _UNITS[match.group(2).lower()]
+    if not math.isfinite(value) or value < 1:
+        raise InputError(f"{option} must be at least one byte, got {text!r}")
+    return int(value)
+
+
+def default_budget():
+    """The memory available now (``MemAvailable`` of /proc/meminfo), or None where unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def require_within_budget(surfaces, budget, where=None):
+    """Raises :class:`MemoryBudgetError` if meshing ``surfaces`` (one after the other) is
+    estimated to need more than ``budget`` bytes. The largest surface decides (the runs do not
+    overlap), plus the meshes kept so far (small next to a BSP)."""
+    if budget is None:
+        return
+    worst = max((estimate_peak_bytes(len(s.points), len(s.triangles)) for s in surfaces), default=0)
+    if worst > budget:
+        biggest = max(surfaces, key=lambda s: len(s.triangles))
+        raise MemoryBudgetError(
+            f"the surface has {len(biggest.triangles)} triangles: meshing it is estimated to need "
+            f"about {format_bytes(worst)}, more than the memory budget of {format_bytes(budget)} "
+            "(--max-memory, default: the memory available now); nothing was done. Raise the "
+            "budget, free memory, or mesh a coarser tessellation (--size for CAD input)",
+            where=where or (biggest.source or None), estimate=worst, budget=budget)
