@@ -99,6 +99,12 @@ class _MenuInjector:
     def __call__(self, workbench_name):
         if workbench_name != "FemWorkbench":
             return
+        from PySide import QtCore
+
+        # The signal comes before FEM's menus are rebuilt: add the entry once they are.
+        QtCore.QTimer.singleShot(0, self._add)
+
+    def _add(self):
         try:
             add_to_fem_mesh_menu(self)
         except Exception as e:  # never break the workbench switch
@@ -108,14 +114,18 @@ class _MenuInjector:
 
 
 def fem_mesh_menu():
-    """FEM's top-level "Mesh" menu in the main window's menu bar, or None."""
+    """FEM's top-level "Mesh" menu (object name ``M&esh``) in the main window, or None."""
     import FreeCADGui
+    from PySide import QtGui
 
-    bar = FreeCADGui.getMainWindow().menuBar()
-    for action in bar.actions():
-        menu = action.menu()
-        if menu is not None and action.text().replace("&", "").strip() == "Mesh":
-            return menu
+    mw = FreeCADGui.getMainWindow()
+    for menu in mw.findChildren(QtGui.QMenu):
+        try:
+            if menu.objectName().replace("&", "") == "Mesh" and \
+                    menu.parent() is mw.menuBar():
+                return menu
+        except RuntimeError:  # a menu of the previous workbench, being deleted
+            continue
     return None
 
 
@@ -134,7 +144,12 @@ def add_to_fem_mesh_menu(holder):
     action.setObjectName(COMMAND_NAME)
     action.setToolTip(TOOL_TIP)
     action.triggered.connect(lambda: FreeCADGui.runCommand(COMMAND_NAME))
-    menu.addAction(action)
+    actions = menu.actions()
+    names = [a.objectName() for a in actions]
+    if GMSH_COMMAND in names and names.index(GMSH_COMMAND) + 1 < len(actions):
+        menu.insertAction(actions[names.index(GMSH_COMMAND) + 1], action)  # right after Gmsh
+    else:
+        menu.addAction(action)
     holder.action = action
     return action
 

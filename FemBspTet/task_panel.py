@@ -51,12 +51,14 @@ class TaskPanelMeshBspTet:
 
         params = QtGui.QGroupBox("Parameters")
         grid = QtGui.QFormLayout(params)
-        self.sb_max = self._length_box(grid, "Max element size", "0 = automatic")
-        self.sb_min = self._length_box(grid, "Min element size", "0 = none (quality stage)")
+        self.sb_max = self._length_box(grid, "Max element size", "0 = automatic", "automatic")
+        self.sb_min = self._length_box(grid, "Min element size", "0 = none (quality stage)",
+                                       "none")
         self.cb_order = QtGui.QComboBox()
         self.cb_order.addItems(["1st", "2nd"])
         grid.addRow("Element order", self.cb_order)
-        self.sb_deflection = self._length_box(grid, "Linear deflection", "0 = automatic")
+        self.sb_deflection = self._length_box(grid, "Linear deflection", "0 = automatic",
+                                              "automatic")
         self.sb_angle = QtGui.QDoubleSpinBox()
         self.sb_angle.setRange(0.1, 179.0)
         self.sb_angle.setDecimals(2)
@@ -104,10 +106,11 @@ class TaskPanelMeshBspTet:
         return form
 
     @staticmethod
-    def _length_box(grid, label, tip):
+    def _length_box(grid, label, tip, zero_text):
         from PySide import QtGui
 
         sb = QtGui.QDoubleSpinBox()
+        sb.setSpecialValueText(zero_text)
         sb.setRange(0.0, 1e9)
         sb.setDecimals(4)
         sb.setSuffix(" mm")

@@ -17,10 +17,12 @@ class VPMeshBspTet:
         vobj.Proxy = self
         self.ViewObject = vobj
         self.Object = vobj.Object
+        self.task_panel = None
 
     def attach(self, vobj):
         self.ViewObject = vobj
         self.Object = vobj.Object
+        self.task_panel = None
 
     def getIcon(self):
         return ICON_PATH
@@ -45,7 +47,8 @@ class VPMeshBspTet:
         if FreeCADGui.Control.activeDialog():
             FreeCADGui.Control.closeDialog()
         vobj.show()
-        FreeCADGui.Control.showDialog(TaskPanelMeshBspTet(vobj.Object))
+        self.task_panel = TaskPanelMeshBspTet(vobj.Object)  # for scripts and tests; not saved
+        FreeCADGui.Control.showDialog(self.task_panel)
         return True
 
     def unsetEdit(self, vobj, mode=0):
@@ -54,6 +57,7 @@ class VPMeshBspTet:
         import FreeCADGui
 
         FreeCADGui.Control.closeDialog()
+        self.task_panel = None
         return True
 
     def doubleClicked(self, vobj):
