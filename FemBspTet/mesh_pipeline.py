@@ -271,8 +271,22 @@ def core_options(params, projection=None):
 # the pipeline
 # ------------------------------------------------------------------------------------------
 
-def mesh_cad_shape(shape, params, progress=None, cancel=None, source=""):
+def brep_copy(shape):
+    """``shape`` written as BREP text and read back: exactly the shape the worker process reads
+    from its job file (BREP text is not bit-exact for every curve, so both paths mesh this copy
+    and give identical meshes)."""
+    import Part
+
+    copy = Part.Shape()
+    copy.importBrepFromString(shape.exportBrepToString())
+    return copy
+
+
+def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_is_brep_copy=False):
     """Mesh every solid of ``shape`` (a ``Part.Shape``) with ``params``; see the module docstring.
+
+    The shape is first replaced by its :func:`brep_copy` (same faces in the same order), unless
+    ``shape_is_brep_copy`` says it already is one (the worker, which read it from BREP).
 
     progress: ``progress(stage, fraction)`` (fraction in [0, 1] or None), called now and then.
     cancel:   ``cancel()`` returning True stops the run with MeshingCancelled.
@@ -295,6 +309,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source=""):
             raise MeshingCancelled("cancelled: no mesh was made")
 
     report("tessellating the CAD faces", 0.0)
+    if not shape_is_brep_copy:
+        shape = brep_copy(shape)
     size = params.max_size if params.max_size > 0 else None
     deflection = params.linear_deflection or \
         cad_tessellation.default_linear_deflection(shape, size)

@@ -14,9 +14,10 @@ Worker side: ``<python> -m FemBspTet.mesh_worker JOB_DIR`` with the checkout on 
 
 Job directory protocol (a private temporary directory, removed by the client):
 
-* ``shape.brep``: the shape to mesh, written with ``Shape.exportBrep`` (BREP keeps the
-  topology, so ``Faces`` come back in the same order; ``face_count`` in the parameters is
-  checked).
+* ``shape.brep``: the shape to mesh as BREP text (``Shape.exportBrepToString``; BREP keeps
+  the topology, so ``Faces`` come back in the same order, and ``face_count`` in the parameters
+  is checked). In-process runs mesh the same BREP copy (``mesh_pipeline.brep_copy``), so both
+  give identical meshes.
 * ``parameters.json``: ``{"parameters": MeshParameters.to_dict(), "face_count": n,
   "source": label}``.
 * stdout lines ``PROGRESS <fraction or -> <stage text>`` while it runs.
@@ -49,7 +50,8 @@ _ERROR_TYPES = {"InputError": InputError, "InternalError": InternalError,
 
 def write_job(job_dir, shape, params, source=""):
     """Write the job files for ``shape`` and ``params`` into ``job_dir``."""
-    shape.exportBrep(os.path.join(job_dir, "shape.brep"))
+    with open(os.path.join(job_dir, "shape.brep"), "w", encoding="utf-8") as f:
+        f.write(shape.exportBrepToString())  # what mesh_pipeline.brep_copy reads, too
     with open(os.path.join(job_dir, "parameters.json"), "w", encoding="utf-8") as f:
         json.dump({"parameters": params.to_dict(), "face_count": len(shape.Faces),
                    "source": source}, f)
@@ -216,7 +218,8 @@ def main(argv=None):
         if len(shape.Faces) != job["face_count"]:
             raise InternalError("the shape came back from BREP with %d faces instead of %d"
                                 % (len(shape.Faces), job["face_count"]))
-        result = mesh_cad_shape(shape, params, progress=progress, source=job.get("source", ""))
+        result = mesh_cad_shape(shape, params, progress=progress, source=job.get("source", ""),
+                                shape_is_brep_copy=True)
         result.save(os.path.join(job_dir, "result.npz"), os.path.join(job_dir, "result.json"))
         return 0
     except Exception as e:  # reported to the client through error.json
