@@ -52,6 +52,7 @@ def main():
             shape = Part.read(path)
         except Exception as e:
             rows.append((name, "-", "-", "unreadable: %s" % e, "", "", ""))
+            print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
         job = MeshJob(shape, MeshParameters(order=args.order, compare_tetgen=False),
                       source=name, python="/usr/bin/python3")
@@ -60,6 +61,7 @@ def main():
             job.cancel()
             rows.append((name, len(shape.Solids), len(shape.Faces),
                          "stopped after %g s" % args.timeout, "", "", ""))
+            print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
         try:
             r = job.result()
