@@ -205,7 +205,8 @@ class TaskPanelMeshBspTet:
             params = parameters_from_object(self.obj)
             self.job = MeshJob(shape_of(self.obj), params, source=self.obj.Label)
             self.job.start()
-        except BspTetError as e:
+        except Exception as e:  # bad parameters, no shape, no worker interpreter, ...
+            e = _as_bsptet_error(e)
             self.job = None
             self._failed(e)
             record_failure(self.obj, e)
@@ -253,9 +254,10 @@ class TaskPanelMeshBspTet:
         self.progress.setRange(0, 1000)
         try:
             result = job.result()
-        except BspTetError as e:
+        except Exception as e:  # the worker's error, or unreadable result files
             from .mesher_tools import record_failure
 
+            e = _as_bsptet_error(e)
             record_failure(self.obj, e)
             self.progress.setValue(0)
             self._failed(e)
@@ -286,7 +288,8 @@ class TaskPanelMeshBspTet:
         doc.openTransaction("Mesh with BspTet")
         try:
             apply_result(self.obj, result)
-        except BspTetError as e:
+        except Exception as e:
+            e = _as_bsptet_error(e)
             doc.abortTransaction()
             self._failed(e)
             return
@@ -343,6 +346,15 @@ class TaskPanelMeshBspTet:
             cells = [self.table.item(row, c) for c in (0, 1)]
             rows.append((label,) + tuple(c.text() if c is not None else "" for c in cells))
         return rows
+
+
+def _as_bsptet_error(error):
+    """``error`` itself if it is one of ours, else an InternalError that names it."""
+    if isinstance(error, BspTetError):
+        return error
+    from .errors import InternalError
+
+    return InternalError("unexpected %s: %s" % (type(error).__name__, error))
 
 
 def _fmt(value):

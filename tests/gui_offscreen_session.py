@@ -1,7 +1,8 @@
-# Runs INSIDE FreeCAD's GUI (offscreen): QT_QPA_PLATFORM=offscreen freecad gui_offscreen_session.py
-# Driven by tests/test_gui_offscreen.py, which gives it a throw-away HOME with the checkout installed
-# as a Mod (~/.local/share/FreeCAD/Mod/FemBspTet) and reads the facts it records (JSON, path in
-# FEMBSPTET_GUI_OUT). It records what it sees and never decides pass/fail itself; every step is
+# Runs INSIDE FreeCAD's GUI (offscreen):
+#     QT_QPA_PLATFORM=offscreen freecad gui_offscreen_session.py
+# Driven by tests/test_gui_offscreen.py, which gives it a throw-away HOME with the checkout
+# installed as a Mod (~/.local/share/FreeCAD/Mod/FemBspTet) and reads the facts it records
+# (JSON, path in FEMBSPTET_GUI_OUT). It records what it sees and never decides pass/fail itself; every step is
 # guarded so that one failure still reports the others. Ends with os._exit (FreeCAD's event loop
 # would otherwise keep running).
 import json
