@@ -38,7 +38,7 @@ import time
 
 import numpy as np
 
-from .errors import InputError, InternalError, MeshingCancelled
+from .errors import BspTetError, InputError, InternalError, MeshingCancelled
 from .mesh_types import TetMesh
 
 #: Name of each MeshParameters field in ``core.tetrahedralize``'s options. The one place to
@@ -326,8 +326,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     try:
         mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
                                           cancel=cancel)
-    except InternalError:
-        check_cancel()  # the core stopped because cancel() said so
+    except BspTetError:
+        check_cancel()  # the core stopped because cancel() said so (whatever error it raised)
         raise
     check_cancel()
 
