@@ -1,3 +1,7 @@
 # FemBspTet: FreeCAD start-up (App side). FreeCAD exec()s this file inside a function, without
-# __file__. Nothing is registered on the App side yet: the mesher document object and its unit
-# tests arrive with the FreeCAD integration (issue 5). Keep this file: FreeCAD looks for it.
+# __file__. The mesher object needs no registration (it is a Fem::FemMeshObjectPython with a
+# Python proxy, FemBspTet.mesher_object); FreeCAD's test runner gets our App tests:
+#     freecadcmd -t TestFemBspTetApp
+import FreeCAD
+
+FreeCAD.__unit_test__ += ["TestFemBspTetApp"]

@@ -193,14 +193,20 @@ def tessellate_file(path, size=None, linear_deflection=None, angular_deflection=
                          % fmt, where=where)
 
     if linear_deflection is None:
-        diag = _diagonal(shape)
-        if not (diag > 0 and math.isfinite(diag)):
-            diag = 1.0  # no extent (a vertex): tessellate_shape refuses it with a clear message
-        if size is not None:
-            linear_deflection = min(size * DEFLECTION_OF_SIZE, diag * DEFLECTION_CAP_OF_DIAGONAL)
-        else:
-            linear_deflection = diag * DEFAULT_DEFLECTION_OF_DIAGONAL
+        linear_deflection = default_linear_deflection(shape, size)
     return tessellate_shape(shape, linear_deflection, angular_deflection, False, source=path)
+
+
+def default_linear_deflection(shape, size=None):
+    """The linear deflection (mm) used when none is given: ``min(size / 10, diag / 200)`` with a
+    target element size, else ``diag / 500`` (``diag``: bounding-box diagonal of ``shape``; see
+    :func:`tessellate_file` for why). A shape without extent counts as ``diag = 1``."""
+    diag = _diagonal(shape)
+    if not (diag > 0 and math.isfinite(diag)):
+        diag = 1.0  # no extent (a vertex): tessellate_shape refuses it with a clear message
+    if size is not None:
+        return min(size * DEFLECTION_OF_SIZE, diag * DEFLECTION_CAP_OF_DIAGONAL)
+    return diag * DEFAULT_DEFLECTION_OF_DIAGONAL
 
 
 def surfaces_to_single(surfaces):

@@ -72,3 +72,8 @@ class TimeLimitReached(Cancelled):
 
 class NotImplementedYetError(InternalError):
     """A feature that is planned but not built yet. Says which, never pretends."""
+
+
+class MeshingCancelled(InternalError):
+    """The user stopped a meshing run (Cancel in the task panel, ``cancel()`` returning True).
+    No mesh was made; an object's previous mesh is kept."""

@@ -207,19 +207,18 @@ def _format_of(path):
 
 
 def write_via_freecad(path, mesh):
-    """Write ``mesh`` with FreeCAD's writer chosen by the extension of ``path``.
-
-    path: ``.unv``, ``.med``, ``.z88``, ``.vtk``, ``.vtu`` or ``.inp`` (any letter case).
-    The FemMesh of :func:`tetmesh_to_femmesh` is written under the target's own file name into a
-    private temporary directory ``.<name>.tmp<pid>_<random>`` next to the target (the writer
-    picks the format from the extension, and the MED writer stores the file's stem as the mesh
-    name that ``Fem.read`` looks for), then renamed over ``path``; on failure the temporary
-    directory is removed and an existing ``path`` is left untouched. Returns the absolute path.
+    """Write ``mesh`` (a :class:`TetMesh`) with FreeCAD's writer chosen by the extension of
+    ``path``: the FemMesh of :func:`tetmesh_to_femmesh`, written by :func:`write_femmesh`.
 
     Raises InputError for an unsupported extension, a missing or unwritable directory, or an
     invalid mesh; InternalError if FreeCAD's writer fails or writes nothing.
     """
     path = os.fspath(path)
+    _check_target(path)
+    return write_femmesh(path, tetmesh_to_femmesh(mesh))
+
+
+def _check_target(path):
     ext = _format_of(path)
     target = os.path.abspath(path)
     directory = os.path.dirname(target)
@@ -229,8 +228,24 @@ def write_via_freecad(path, mesh):
         raise InputError("directory %s is not writable" % directory, where=path)
     if os.path.isdir(target):
         raise InputError("is a directory", where=path)
+    return ext, target, directory
 
-    fem = tetmesh_to_femmesh(mesh)
+
+def write_femmesh(path, fem):
+    """Write the ``Fem.FemMesh`` ``fem`` with FreeCAD's writer chosen by the extension of ``path``.
+
+    path: ``.unv``, ``.med``, ``.z88``, ``.vtk``, ``.vtu`` or ``.inp`` (any letter case).
+    The mesh is written under the target's own file name into a private temporary directory
+    ``.<name>.tmp<pid>_<random>`` next to the target (the writer picks the format from the
+    extension, and the MED writer stores the file's stem as the mesh name that ``Fem.read``
+    looks for), then renamed over ``path``; on failure the temporary directory is removed and an
+    existing ``path`` is left untouched. Returns the absolute path.
+
+    Raises InputError for an unsupported extension, a missing or unwritable directory;
+    InternalError if FreeCAD's writer fails or writes nothing.
+    """
+    path = os.fspath(path)
+    ext, target, directory = _check_target(path)
     # The temporary file keeps the target's base name: FemMesh.write picks the format from the
     # extension, and the MED writer names the mesh inside the file after the file's stem (which
     # Fem.read then looks up), so it lives in a private directory next to the target instead.

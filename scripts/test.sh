@@ -8,7 +8,7 @@ BUILD_DIR=${FEMBSPTET_BUILD_DIR:-$ROOT/build}
 
 status=0
 echo "== C++ tests (CTest) =="
-ctest --test-dir "$BUILD_DIR" --output-on-failure --timeout 1800 || status=1
+ctest --test-dir "$BUILD_DIR" --output-on-failure --timeout 1800 -j "$(nproc)" || status=1
 echo "== Python tests (pytest) =="
 cd "$ROOT" && /usr/bin/python3 -m pytest -q -p no:cacheprovider tests "$@" || status=1
 exit $status

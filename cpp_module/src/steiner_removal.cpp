@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -194,6 +195,8 @@ class TetComplex {
   std::string why;  ///< why the last relocate() failed
   std::int64_t merged = 0;  ///< interior points removed with a relocated surface point
   int grow_limit = 16;      ///< cavity growth steps per candidate point (relocate)
+  std::size_t max_cavity = 4000;  ///< tets in a grown cavity, at most
+  int deep_grow_limit = 64;  ///< cavity growth steps per deep candidate (relocate; 0: no deep candidates)
   std::size_t max_candidates = 1000;
   /// Removes v and the Steiner points `also` (any of them may be on the surface) and cones their
   /// cavity from one new double point w (header comment: RELOCATE). The surface faces that touch a
@@ -305,26 +308,10 @@ class TetComplex {
     std::sort(cavity.begin(), cavity.end());
     cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
     auto cavity_bases = [&](const std::vector<Index>& cav) {
-      // Outward faces of the cavity: faces of its tets, without a removed point, that appear once.
-      std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
-      for (Index id : cav) {
-        const auto& t = tets_[id];
-        const std::array<std::array<Index, 3>, 4> fs = {{{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
-        for (const auto& f : fs) {
-          if (is_removed(f[0]) || is_removed(f[1]) || is_removed(f[2])) continue;
-          std::array<Index, 3> key = f;
-          std::sort(key.begin(), key.end());
-          all.push_back({key, f});
-        }
-      }
-      std::sort(all.begin(), all.end());
+      // Outward faces of the cavity without a removed point, and the new surface triangles.
       std::vector<std::array<Index, 3>> out;
-      for (std::size_t i = 0; i < all.size();) {
-        std::size_t j = i + 1;
-        while (j < all.size() && all[j].first == all[i].first) ++j;
-        if (j - i == 1) out.push_back(all[i].second);
-        i = j;
-      }
+      for (const auto& f : boundary_faces(cav))
+        if (!is_removed(f[0]) && !is_removed(f[1]) && !is_removed(f[2])) out.push_back(f);
       for (const auto& f : new_faces) out.push_back(f);
       return out;
     };
@@ -429,6 +416,7 @@ class TetComplex {
         candidates.push_back({vr.x + f * (q.x - vr.x), vr.y + f * (q.y - vr.y), vr.z + f * (q.z - vr.z)});
     }
     if (candidates.empty() || !(lref > 0)) return fail("no direction into the solid sees all its faces");
+    std::size_t num_fat = 0;  // candidates with a clearance of at least 1e-3 of the star's size
     // Deepest first: a point that hugs a face becomes an obstacle for the next relocation (a plane
     // a few ulps away), so order by the clearance to the cavity faces, estimated in doubles (the
     // exact checks below decide). Candidates that look outside go last, in their order.
@@ -443,10 +431,49 @@ class TetComplex {
       }
       std::stable_sort(order.begin(), order.end());
       std::vector<Vec3> sorted;
-      for (const auto& [key, i] : order) sorted.push_back(candidates[i]);
+      for (const auto& [key, i] : order) {
+        if (-key >= 1e-3 * lref) ++num_fat;
+        sorted.push_back(candidates[i]);
+      }
       candidates.swap(sorted);
     }
     if (candidates.size() > max_candidates) candidates.resize(max_candidates);
+    num_fat = std::min(num_fat, candidates.size());
+    // Deep candidates, tried last with a larger cavity growth: points well inside the solid (the
+    // centroids of v's tets and of the cavity's vertices) are not blocked by earlier relocated
+    // points that hug the surface; the faces they do not see are removed by growing the cavity.
+    const std::size_t first_deep = candidates.size();
+    if (deep_grow_limit > 0) {
+      Vec3 c{0, 0, 0};
+      std::size_t nc = 0;
+      for (const auto& f : bases)
+        for (Index x : f) {
+          const Vec3 q = geo_.rounded(x);
+          c = {c.x + q.x, c.y + q.y, c.z + q.z};
+          ++nc;
+        }
+      c = {c.x / nc, c.y / nc, c.z / nc};
+      for (double f : {1.0, 0.5, 0.25})
+        candidates.push_back({vr.x + f * (c.x - vr.x), vr.y + f * (c.y - vr.y), vr.z + f * (c.z - vr.z)});
+      const Vec3 d = unit(dir);
+      for (double f : {0.5, 0.25, 0.1})
+        candidates.push_back({vr.x + f * lref * d.x, vr.y + f * lref * d.y, vr.z + f * lref * d.z});
+      for (Index id : vt_[v]) {
+        Vec3 tc{0, 0, 0};
+        for (Index x : tets_[id]) {
+          const Vec3 q = geo_.rounded(x);
+          tc = {tc.x + 0.25 * q.x, tc.y + 0.25 * q.y, tc.z + 0.25 * q.z};
+        }
+        candidates.push_back(tc);
+      }
+      if (candidates.size() > first_deep + 24) candidates.resize(first_deep + 24);
+    }
+    // Order: fat candidates, then deep ones (with growth), then the shallow ones: a point left a
+    // few ulps under the surface blocks the relocations around it.
+    const std::size_t num_deep = candidates.size() - first_deep;
+    std::rotate(candidates.begin() + static_cast<std::ptrdiff_t>(num_fat),
+                candidates.begin() + static_cast<std::ptrdiff_t>(first_deep), candidates.end());
+    auto is_deep = [&](std::size_t attempt) { return attempt >= num_fat && attempt < num_fat + num_deep; };
     for (std::size_t attempt = 0; attempt < candidates.size(); ++attempt) {
       const Vec3 w = candidates[attempt];
       // Double pre-checks are not exact; everything is decided on the new vertex below.
@@ -457,32 +484,38 @@ class TetComplex {
       std::vector<std::array<Index, 3>> bs = bases;
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
-      const int max_grow = attempt < 12 ? grow_limit : 0;  // bounded work per candidate
+      const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
       for (int grow = 0; grow <= max_grow; ++grow) {
+        // Cone from w; every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
-        std::array<Index, 3> bad{-1, -1, -1};
+        std::vector<std::array<Index, 3>> bad;
         for (const auto& f : bs) {
           const std::array<Index, 4> t{f[0], f[2], f[1], wid};
           if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) {
-            bad = f;
-            break;
+            bad.push_back(f);
+            if (grow == max_grow) break;  // no growth left: one bad face decides
+          } else {
+            repl.push_back(t);
           }
-          repl.push_back(t);
         }
-        if (bad[0] < 0) {
+        if (bad.empty()) {
           ok = true;
           break;
         }
-        // The tet beyond `bad`: it has all three vertices and is not in the cavity.
-        Index beyond = -1;
-        for (Index id : vt_[bad[0]]) {
-          const auto& t = tets_[id];
-          if (std::find(t.begin(), t.end(), bad[1]) != t.end() && std::find(t.begin(), t.end(), bad[2]) != t.end() &&
-              !std::binary_search(cav.begin(), cav.end(), id))
-            beyond = id;
+        if (grow == max_grow) break;
+        std::vector<Index> add;
+        for (const auto& f : bad) {
+          const Index beyond = tet_beyond(f, cav);
+          if (beyond < 0) {  // a surface face (or a new one): w is on its wrong side
+            add.clear();
+            break;
+          }
+          add.push_back(beyond);
         }
-        if (beyond < 0) break;  // a surface face (or a new one): w is on its wrong side
-        cav.insert(std::upper_bound(cav.begin(), cav.end(), beyond), beyond);
+        if (add.empty() || cav.size() + add.size() > max_cavity) break;
+        cav.insert(cav.end(), add.begin(), add.end());
+        std::sort(cav.begin(), cav.end());
+        cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
         bs = cavity_bases(cav);
       }
       if (!ok) continue;
@@ -495,6 +528,182 @@ class TetComplex {
     }
     return fail("no double-precision point just inside keeps its tets positive");
   }
+  /// Removes the interior Steiner point v by re-coning a cavity from its neighbour u: the cavity
+  /// starts as v's star and takes the tet beyond every face u does not see (never across a surface
+  /// face), at most `max_grow` times and up to `max_tets` tets. The cone from u over the cavity's
+  /// boundary faces that do not contain u tiles the cavity when every cone tet is positive (the
+  /// argument of COLLAPSE, which is the case without growth). Interior Steiner points strictly
+  /// inside the grown cavity vanish with v. Returns false, changing nothing, otherwise.
+  bool cone_from_vertex(Index v, Index u, int max_grow, std::size_t max_tets) {
+    if (!vb_[v].empty() || v < np_) return false;
+    std::vector<Index> cav = vt_[v];
+    std::sort(cav.begin(), cav.end());
+    std::vector<std::array<Index, 4>> repl;
+    for (int grow = 0; grow <= max_grow; ++grow) {
+      const std::vector<std::array<Index, 3>> bs = boundary_faces(cav);
+      repl.clear();
+      std::vector<Index> add;
+      bool stop = false;
+      for (const auto& f : bs) {
+        if (f[0] == u || f[1] == u || f[2] == u) continue;
+        const std::array<Index, 4> t{f[0], f[2], f[1], u};
+        if (geo_.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive) {
+          repl.push_back(t);
+          continue;
+        }
+        if (grow == max_grow) return false;
+        const Index beyond = tet_beyond(f, cav);
+        if (beyond < 0) {
+          stop = true;
+          break;
+        }
+        add.push_back(beyond);
+      }
+      if (stop) return false;
+      if (add.empty()) break;
+      if (cav.size() + add.size() > max_tets) return false;
+      cav.insert(cav.end(), add.begin(), add.end());
+      std::sort(cav.begin(), cav.end());
+      cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
+    }
+    // Vertices that vanish (strictly inside the cavity) must be interior Steiner points.
+    std::vector<Index> before, after;
+    for (Index id : cav)
+      for (Index x : tets_[id]) before.push_back(x);
+    for (const auto& t : repl)
+      for (Index x : t) after.push_back(x);
+    std::sort(before.begin(), before.end());
+    before.erase(std::unique(before.begin(), before.end()), before.end());
+    std::sort(after.begin(), after.end());
+    after.erase(std::unique(after.begin(), after.end()), after.end());
+    std::int64_t gone = 0;
+    for (Index x : before)
+      if (!std::binary_search(after.begin(), after.end(), x)) {
+        if (x < np_ || !vb_[x].empty()) return false;
+        ++gone;
+      }
+    if (!tets_are_new(repl, cav)) return false;
+    for (Index id : cav) kill_tet(id);
+    for (const auto& t : repl) add_tet(t);
+    merged += gone - 1;  // v itself counts as a collapse
+    return true;
+  }
+
+  /// EDGE REMOVAL (an n-to-2(n-2) flip): the n tets around the interior edge (v, x) are replaced by
+  /// the cones from x and from v over a triangulation of their ring polygon a_0..a_{n-1} (oriented
+  /// so that every (v, x, a_i, a_i+1) is positive): tets (p, q, r, x) and (p, r, q, v) for each
+  /// triangle (p, q, r) in ring order. The outer faces (v or x, a_i, a_i+1) are kept, so the result
+  /// is conforming; it is taken when every new tet is positive (the first triangulation found, in
+  /// a fixed order). n <= 7. Returns false, changing nothing, otherwise.
+  bool remove_edge(Index v, Index x) {
+    std::vector<Index> around;
+    for (Index id : vt_[v]) {
+      const auto& t = tets_[id];
+      if (std::find(t.begin(), t.end(), x) != t.end()) around.push_back(id);
+    }
+    const std::size_t n = around.size();
+    if (n < 3 || n > 7) return false;
+    std::map<Index, Index> next;
+    for (Index id : around) {
+      const std::array<Index, 4>& t = tets_[id];
+      // The other two, p and q, ordered so that (v, x, p, q) is an even permutation of the stored
+      // (positive) tet.
+      int pos[4], k = 2;
+      Index pq[2] = {-1, -1};
+      for (int i = 0; i < 4; ++i) {
+        if (t[i] == v) pos[0] = i;
+        else if (t[i] == x) pos[1] = i;
+        else pq[k - 2] = t[i], pos[k++] = i;
+      }
+      int inversions = 0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) inversions += pos[i] > pos[j];
+      if (inversions % 2) std::swap(pq[0], pq[1]);
+      if (next.count(pq[0])) return false;
+      next[pq[0]] = pq[1];
+    }
+    std::vector<Index> ring{next.begin()->first};
+    while (ring.size() < n) {
+      auto it = next.find(ring.back());
+      if (it == next.end()) return false;
+      ring.push_back(it->second);
+    }
+    if (next[ring.back()] != ring[0]) return false;
+    // Triangulations of the ring polygon, enumerated recursively (fan-first order).
+    std::vector<std::array<Index, 4>> repl;
+    std::function<bool(std::vector<Index>)> solve = [&](std::vector<Index> poly) -> bool {
+      const std::size_t m = poly.size();
+      if (m < 3) return true;
+      // The triangle on edge (poly[0], poly[m-1]) with apex poly[k].
+      for (std::size_t k = 1; k + 1 < m; ++k) {
+        const Index p = poly[0], q = poly[k], r = poly[m - 1];
+        if (geo_.orient3d(p, q, r, x) != Sign::kPositive || geo_.orient3d(p, r, q, v) != Sign::kPositive) continue;
+        const std::size_t mark = repl.size();
+        repl.push_back({p, q, r, x});
+        repl.push_back({p, r, q, v});
+        if (solve(std::vector<Index>(poly.begin(), poly.begin() + static_cast<std::ptrdiff_t>(k + 1))) &&
+            solve(std::vector<Index>(poly.begin() + static_cast<std::ptrdiff_t>(k), poly.end())))
+          return true;
+        repl.resize(mark);
+      }
+      return false;
+    };
+    if (!solve(ring)) return false;
+    std::sort(around.begin(), around.end());
+    if (!tets_are_new(repl, around)) return false;
+    for (Index id : around) kill_tet(id);
+    for (const auto& t : repl) add_tet(t);
+    return true;
+  }
+
+  /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
+  std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
+    std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
+    for (Index id : cav) {
+      const auto& t = tets_[id];
+      const std::array<std::array<Index, 3>, 4> fs = {
+          {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+      for (const auto& f : fs) {
+        std::array<Index, 3> key = f;
+        std::sort(key.begin(), key.end());
+        all.push_back({key, f});
+      }
+    }
+    std::sort(all.begin(), all.end());
+    std::vector<std::array<Index, 3>> out;
+    for (std::size_t i = 0; i < all.size();) {
+      std::size_t j = i + 1;
+      while (j < all.size() && all[j].first == all[i].first) ++j;
+      if (j - i == 1) out.push_back(all[i].second);
+      i = j;
+    }
+    return out;
+  }
+  /// The tet across face f from the cavity `cav` (sorted), or -1 (a surface face).
+  Index tet_beyond(const std::array<Index, 3>& f, const std::vector<Index>& cav) const {
+    for (Index id : vt_[f[0]]) {
+      const auto& t = tets_[id];
+      if (std::find(t.begin(), t.end(), f[1]) != t.end() && std::find(t.begin(), t.end(), f[2]) != t.end() &&
+          !std::binary_search(cav.begin(), cav.end(), id))
+        return id;
+    }
+    return -1;
+  }
+  /// Topological safeguard: no new tet duplicates a tet outside the cavity.
+  bool tets_are_new(const std::vector<std::array<Index, 4>>& repl, const std::vector<Index>& cav) const {
+    for (const auto& t : repl) {
+      std::array<Index, 4> key = t;
+      std::sort(key.begin(), key.end());
+      for (Index id : vt_[t[0]]) {
+        if (std::binary_search(cav.begin(), cav.end(), id)) continue;
+        std::array<Index, 4> k2 = tets_[id];
+        std::sort(k2.begin(), k2.end());
+        if (k2 == key) return false;
+      }
+    }
+    return true;
+  }
+
   bool fail(const std::string& reason) {
     why = reason;
     return false;
@@ -659,6 +868,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
   // Merge: an interior Steiner point that cannot collapse is replaced, with its interior Steiner
   // neighbours, by one new point (a cavity re-coned from it), then collapses are tried again.
   mesh.grow_limit = 0;
+  mesh.deep_grow_limit = 0;
   mesh.max_candidates = 8;
   for (int pass = 0; pass < 3; ++pass) {
     std::int64_t merged_before = mesh.merged;
@@ -673,6 +883,75 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     }
     if (mesh.merged == merged_before) break;
     collapse_passes(0.8 + 0.03 * pass, 0.83 + 0.03 * pass);
+  }
+
+  // Interior Steiner points left: re-cone a grown cavity from a neighbour (a collapse that may
+  // first take neighbouring tets, and the interior Steiner points among them, into v's star).
+  for (int pass = 0; pass < 4; ++pass) {
+    const std::int64_t merged_before = mesh.merged;
+    std::int64_t removed = 0;
+    for (Index v : steiner_vertices()) {
+      check_cancel();
+      if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+      for (Index u : mesh.neighbours(v))
+        if (mesh.cone_from_vertex(v, u, 6, 400)) {
+          ++removed;
+          break;
+        }
+    }
+    st.collapsed += removed;
+    if (removed == 0 && mesh.merged == merged_before) break;
+    collapse_passes(0.9, 0.95);
+  }
+  // Those left: lower their degree by edge removals (each one takes a neighbour away from v), and
+  // collapse or re-cone after each one.
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    bool gone = false;
+    for (int flips = 0; flips < 64 && !gone; ++flips) {
+      std::vector<std::pair<std::size_t, Index>> by_ring;
+      for (Index x : mesh.neighbours(v)) {
+        std::size_t ring = 0;
+        for (Index id : mesh.star(v)) {
+          const auto& t = mesh.tet(id);
+          ring += std::find(t.begin(), t.end(), x) != t.end();
+        }
+        by_ring.push_back({ring, x});
+      }
+      std::sort(by_ring.begin(), by_ring.end());
+      bool flipped = false;
+      for (const auto& [ring, x] : by_ring)
+        if ((flipped = mesh.remove_edge(v, x))) break;
+      if (!flipped) break;
+      ++st.flips;
+      for (Index u : mesh.neighbours(v))
+        if (mesh.try_substitute(v, u) || mesh.cone_from_vertex(v, u, 6, 400)) {
+          gone = true;
+          ++st.collapsed;
+          break;
+        }
+    }
+  }
+  // The few left: cones from farther vertices (the nearest 48, input points among them first
+  // when equally near) over cavities grown further.
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    const Vec3 pv = geo.rounded(v);
+    std::vector<std::pair<double, Index>> near;
+    for (Index u = 0; u < geo.num_vertices(); ++u) {
+      if (u == v || !mesh.used(u)) continue;
+      const Vec3 q = geo.rounded(u);
+      near.push_back({(q.x - pv.x) * (q.x - pv.x) + (q.y - pv.y) * (q.y - pv.y) + (q.z - pv.z) * (q.z - pv.z), u});
+    }
+    const std::size_t k = std::min<std::size_t>(48, near.size());
+    std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
+    for (std::size_t i = 0; i < k; ++i)
+      if (mesh.cone_from_vertex(v, near[i].second, 24, 2000)) {
+        ++st.collapsed;
+        break;
+      }
   }
 
   // Round the implicit points left.

@@ -23,12 +23,28 @@
 //    sees every link face strictly, and the intersection of the inner half-spaces of at most two
 //    input planes near v is a non-empty wedge. Each candidate is checked exactly.
 //
+//    Candidates are tried fat first (clear of every face by 1e-3 of the star's size), then deep
+//    ones (centroids of v's tets and of its cavity) with cavity growth: every face w does not see
+//    takes the tet beyond it (never across the surface) into the cavity, until w sees all.
+//
+//  * CONE an interior Steiner point v from a vertex u over a grown cavity (v's star plus tets
+//    beyond the faces u does not see): the cone over the cavity's boundary faces that do not
+//    contain u tiles it when every cone tet is positive (the COLLAPSE argument). Vertices strictly
+//    inside the cavity must be interior Steiner points; they vanish with v.
+//
+//  * EDGE REMOVAL (n-to-2(n-2) flip, n <= 7) of an interior edge (v, x): the n tets around it are
+//    replaced by the cones from v and x over a triangulation of their ring polygon, when all are
+//    positive; the outer faces are kept, so the complex stays conforming. Used to lower the degree
+//    of an interior Steiner point until it collapses.
+//
 //  * ROUND an implicit interior point: the nearest doubles, else points pulled towards the centroid
 //    of its neighbours, taken only if every tet around it stays positive.
 //
 // Order: collapse passes over all Steiner points until none applies; relocate the surface ones that
-// remain (unless boundary Steiner points are allowed and are exactly doubles); collapse
-// passes again; round what is left. Input points never move. Deterministic: vertices in id order,
+// remain (unless boundary Steiner points are allowed and are exactly doubles); collapse passes
+// again; merge interior points with their interior Steiner neighbours; cones from neighbours over
+// grown cavities; edge removals then collapses; cones from the 48 nearest vertices; round what is
+// left. Input points never move. Deterministic: vertices in id order,
 // neighbours input points first, then by id.
 #pragma once
 
@@ -51,7 +67,7 @@ struct SteinerRemovalOptions {
 
 struct SteinerRemovalStats {
   std::int64_t steiner_before = 0, boundary_steiner_before = 0;
-  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0;
+  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0, flips = 0;
   std::int64_t boundary_steiner_after = 0;
 };
 

@@ -1,0 +1,159 @@
+"""CalculiX acceptance cases of the FreeCAD mesher (issue 5), headless: the same analysis solved
+with our mesh and with FreeCAD's Gmsh mesh at the same size.
+
+* ``cantilever``: steel box 8000 x 1000 x 1000 mm, Face1 (x = 0) fixed, 9e6 N in -z on Face2
+  (x = L) (``/work/shared/design/freecad.md`` §6; Gmsh tet10 at size 500: 88.15 mm).
+* ``plate_with_hole``: steel plate 200 x 100 x 10 mm with a hole of radius 20 mm through its
+  centre, Face1 (x = 0) fixed, 100 MPa pressure on the hole's cylindrical face.
+
+    case = build_case(doc, "cantilever")          # part, analysis, solver, constraints
+    mesh = add_bspt_mesh(case, max_size=500, order=2)    or    add_gmsh_mesh(case, 500, 2)
+    figures = solve(case, workdir)                # {"max_displacement_mm", "min_uz_mm", ...}
+
+Needs FreeCAD (Debian freecad-python3), ``ccx`` and ``gmsh`` on PATH.
+"""
+
+import math
+
+from ..errors import InternalError
+
+#: Steel, as in freecad.md §6.
+YOUNGS_MODULUS = "210000 MPa"
+POISSON_RATIO = "0.30"
+
+CASES = {
+    "cantilever": {"size": 500.0, "gmsh_reference_mm": 88.15},
+    "plate_with_hole": {"size": 10.0, "hole_radius": 20.0, "pressure_mpa": 100.0},
+}
+
+
+class Case:
+    """A built analysis: ``doc``, ``part``, ``analysis``, ``solver``, ``loaded_face`` (the face
+    name carrying the load), ``mesh`` (set by add_*_mesh)."""
+
+    def __init__(self, name, doc, part, analysis, solver, loaded_face):
+        self.name, self.doc, self.part = name, doc, part
+        self.analysis, self.solver, self.loaded_face = analysis, solver, loaded_face
+        self.mesh = None
+
+
+def build_case(doc, name):
+    """Part, analysis, CalculiX solver, steel, constraints of case ``name`` in ``doc``."""
+    import FreeCAD
+    import ObjectsFem
+    import Part
+
+    if name == "cantilever":
+        part = doc.addObject("Part::Box", "Box")
+        part.Length, part.Width, part.Height = 8000.0, 1000.0, 1000.0
+    elif name == "plate_with_hole":
+        r = CASES[name]["hole_radius"]
+        part = doc.addObject("Part::Feature", "Plate")
+        part.Shape = Part.makeBox(200.0, 100.0, 10.0).cut(
+            Part.makeCylinder(r, 10.0, FreeCAD.Vector(100.0, 50.0, 0.0)))
+    else:
+        raise InternalError("unknown CalculiX case %r (known: %s)" % (name, ", ".join(CASES)))
+    doc.recompute()
+
+    analysis = ObjectsFem.makeAnalysis(doc, "Analysis")
+    solver = ObjectsFem.makeSolverCalculixCcxTools(doc, "CalculiXccxTools")
+    solver.AnalysisType = "static"
+    solver.GeometricalNonlinearity = "linear"
+    analysis.addObject(solver)
+    mat = ObjectsFem.makeMaterialSolid(doc, "Steel")
+    m = mat.Material
+    m["Name"] = "Steel"
+    m["YoungsModulus"] = YOUNGS_MODULUS
+    m["PoissonRatio"] = POISSON_RATIO
+    mat.Material = m
+    analysis.addObject(mat)
+
+    fix = ObjectsFem.makeConstraintFixed(doc, "Fixed")
+    fix.References = [(part, "Face1")]  # x = 0 in both cases
+    analysis.addObject(fix)
+    if name == "cantilever":
+        force = ObjectsFem.makeConstraintForce(doc, "Force")
+        force.References = [(part, "Face2")]
+        force.Force = 9.0e6
+        force.Direction = (part, ["Edge5"])
+        force.Reversed = True
+        analysis.addObject(force)
+        loaded = "Face2"
+    else:
+        loaded = hole_face_name(part.Shape)
+        pressure = ObjectsFem.makeConstraintPressure(doc, "Pressure")
+        pressure.References = [(part, loaded)]
+        pressure.Pressure = CASES[name]["pressure_mpa"]
+        analysis.addObject(pressure)
+    return Case(name, doc, part, analysis, solver, loaded)
+
+
+def hole_face_name(shape):
+    """Name of the (single) cylindrical face of ``shape``."""
+    names = ["Face%d" % (k + 1) for k, f in enumerate(shape.Faces)
+             if type(f.Surface).__name__ == "Cylinder"]
+    if len(names) != 1:
+        raise InternalError("expected one cylindrical face, found %d" % len(names))
+    return names[0]
+
+
+def add_bsptet_mesh(case, max_size, order, **properties):
+    """Our mesher object for the case's part, meshed (run_mesher) and added to the analysis."""
+    from ..mesher_object import make_mesher
+    from ..mesher_tools import run_mesher
+
+    obj = make_mesher(case.doc, case.part, CharacteristicLengthMax=max_size,
+                      ElementOrder="2nd" if order == 2 else "1st", CompareWithTetGen=False,
+                      **properties)
+    run_mesher(obj)
+    case.analysis.addObject(obj)
+    case.mesh = obj
+    return obj
+
+
+def add_gmsh_mesh(case, max_size, order):
+    """FreeCAD's Gmsh mesher object at ``CharacteristicLengthMax = max_size``, meshed."""
+    import ObjectsFem
+    from femmesh.gmshtools import GmshTools
+
+    obj = ObjectsFem.makeMeshGmsh(case.doc, "MeshGmsh")
+    obj.Part = case.part
+    obj.CharacteristicLengthMax = max_size
+    obj.ElementOrder = "2nd" if order == 2 else "1st"
+    case.doc.recompute()
+    error = GmshTools(obj).create_mesh()
+    if error:
+        raise InternalError("Gmsh failed: %s" % error)
+    case.analysis.addObject(obj)
+    case.mesh = obj
+    return obj
+
+
+def solve(case, workdir):
+    """Run CalculiX on the case; returns the figures (displacements in mm)."""
+    from femtools import ccxtools
+
+    fea = ccxtools.FemToolsCcx(case.analysis, case.solver)
+    fea.purge_results()
+    fea.update_objects()
+    fea.setup_working_dir(workdir)
+    fea.setup_ccx()
+    message = fea.check_prerequisites()
+    if message:
+        raise InternalError("CalculiX prerequisites: %s" % message)
+    fea.write_inp_file()
+    fea.ccx_run()
+    fea.load_results()
+    results = [o for o in case.analysis.Group if o.isDerivedFrom("Fem::FemResultObject")]
+    if not results:
+        raise InternalError("CalculiX gave no result (see %s)" % workdir)
+    r = results[0]
+    lengths = list(r.DisplacementLengths)
+    fem = case.mesh.FemMesh
+    return {
+        "nodes": fem.NodeCount,
+        "tets": fem.VolumeCount,
+        "max_displacement_mm": max(lengths),
+        "min_uz_mm": min(v.z for v in r.DisplacementVectors),
+        "finite": all(math.isfinite(x) for x in lengths),
+    }

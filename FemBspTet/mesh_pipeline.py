@@ -1,0 +1,614 @@
+"""CAD shape -> tet mesh whose boundary nodes lie on the CAD faces: the meshing pipeline behind the
+FreeCAD mesher object, without any document object.
+
+    params = MeshParameters(max_size=500.0, order=2)
+    result = mesh_cad_shape(shape, params, progress=None, cancel=None)    # -> MeshResult
+
+Used in-process by ``run_mesher`` / ``mesh_shape`` (:mod:`FemBspTet.mesher_tools`) and in the
+worker process of the task panel (:mod:`FemBspTet.mesh_worker`). Needs FreeCAD's ``Part``
+(OpenCASCADE), never a document or the GUI.
+
+Stages:
+
+1. Tessellate every solid of ``shape`` into a closed, face-tagged surface
+   (:func:`FemBspTet.cad_tessellation.tessellate_shape`; linear deflection from
+   :attr:`MeshParameters.linear_deflection`, or the default tied to the element size).
+2. ``core.tetrahedralize(surfaces, options)``: options from :func:`core_options`. The OCCT
+   projection hook (:class:`FemBspTet.cad_projection.CadProjection`) is passed as
+   ``options["projection"]`` when the core accepts it (the quality stage adds it).
+3. Boundary faces of the tet mesh, each with the CAD face tag of the input triangle it lies on
+   (matched by exact corner coordinates; faces with boundary Steiner points by the nearest
+   input triangle).
+4. Every boundary node that is not a tessellation vertex is put on its CAD geometry: tet10
+   mid-nodes of surface edges inside a face onto that face, those of edges between two faces
+   onto the CAD edge the faces share, boundary Steiner points likewise. Tessellation vertices
+   already lie on their faces and are not moved. Interior mid-nodes stay straight
+   (``/work/shared/design/freecad.md`` §7, mesh contract). Projection is idempotent, so this is
+   harmless when the core already applied the hook.
+5. Moved nodes must not invert an element: every tet with a moved node is checked (positive
+   signed volume of the corners; for tet10 a positive Jacobian determinant at the 10 nodes and
+   the centroid). A failure raises InternalError naming the tet and the CAD face.
+6. Optionally ``tetgen -pY`` on the same surfaces, for the comparison table.
+"""
+
+import dataclasses
+import json
+import math
+import time
+
+import numpy as np
+
+from .errors import BspTetError, InputError, InternalError, MeshingCancelled
+from .mesh_types import TetMesh
+
+#: Name of each MeshParameters field in ``core.tetrahedralize``'s options. The one place to
+#: adapt when the quality stage (issue 4) settles its option names.
+CORE_OPTION_OF = {
+    "max_size": "size",
+    "min_size": "min_size",
+    "quality_bound": "radius_edge_bound",
+    "order": "order",
+    "allow_boundary_steiner": "allow_boundary_steiner",
+}
+#: Option under which the core takes the projection hook ``(point, face_tag) -> point``.
+CORE_PROJECTION_OPTION = "projection"
+#: What the core accepts when it does not list its options in ``core.OPTION_NAMES`` (the core
+#: before the quality stage: no size control, no quality bound, no projection hook).
+CORE_OPTIONS_WITHOUT_QUALITY_STAGE = ("allow_boundary_steiner", "order", "size")
+
+#: FreeCAD property name of each MeshParameters field (for messages that name what to change).
+PROPERTY_OF = {
+    "max_size": "CharacteristicLengthMax",
+    "min_size": "CharacteristicLengthMin",
+    "order": "ElementOrder",
+    "linear_deflection": "LinearDeflection",
+    "angular_deflection": "AngularDeflection",
+    "quality_bound": "QualityBound",
+    "allow_boundary_steiner": "AllowBoundarySteiner",
+    "face_groups": "FaceGroups",
+    "compare_tetgen": "CompareWithTetGen",
+}
+
+#: Prefix of the FemMesh node group made for each CAD face (``BspTet_Face3``). FEM's CalculiX
+#: writer only uses groups named ``<constraint object name>_...``; this prefix avoids them.
+FACE_GROUP_PREFIX = "BspTet_"
+
+#: Switches of the TetGen run the comparison uses (``tetgen -pY``: the same surface, no Steiner
+#: point on it, no quality or size bound, as our core without the quality stage).
+TETGEN_SWITCHES = "pY"
+
+_TET10_EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
+#: Outward faces of a positive tet (a, b, c, d): opposite d, c, a, b.
+_OUTWARD_FACES = ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2))
+
+
+@dataclasses.dataclass
+class MeshParameters:
+    """What the mesher object's properties ask for. Lengths in mm, angles in radians.
+
+    max_size:               maximum element size h (CharacteristicLengthMax); 0 = automatic.
+                            Sets the tessellation's default deflection; volume size control
+                            needs the quality stage of the core.
+    min_size:               minimum element size (CharacteristicLengthMin); 0 = none. Needs the
+                            quality stage (refused with a message otherwise).
+    order:                  1 (tet4) or 2 (tet10).
+    linear_deflection:      distance between the tessellation and the CAD surface; 0 = automatic
+                            (``cad_tessellation.default_linear_deflection``).
+    angular_deflection:     angle between neighbouring triangles' normals (OCCT default 0.5).
+    quality_bound:          radius-edge ratio bound of quality refinement; 0 = no refinement.
+                            Needs the quality stage (refused with a message otherwise).
+    allow_boundary_steiner: keep Steiner points on the surface (they are projected onto the CAD).
+    face_groups:            one FemMesh node group per CAD face (``BspTet_Face<k>``).
+    compare_tetgen:         also run ``tetgen -pY`` on the same surface and report its counts.
+    """
+
+    max_size: float = 0.0
+    min_size: float = 0.0
+    order: int = 2
+    linear_deflection: float = 0.0
+    angular_deflection: float = 0.5
+    quality_bound: float = 0.0
+    allow_boundary_steiner: bool = False
+    face_groups: bool = False
+    compare_tetgen: bool = False
+
+    def validate(self):
+        """Raise InputError naming the property if a value is out of range; return self."""
+        for name in ("max_size", "min_size", "linear_deflection", "quality_bound"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError("%s must be a finite number >= 0 (0 = automatic/off), got %r"
+                                 % (PROPERTY_OF[name], value))
+        if not (math.isfinite(self.angular_deflection) and 0 < self.angular_deflection < math.pi):
+            raise InputError("%s must be between 0 and 180 degrees (exclusive), got %g rad"
+                             % (PROPERTY_OF["angular_deflection"], self.angular_deflection))
+        if self.order not in (1, 2):
+            raise InputError("%s must be 1st or 2nd (order 1 or 2), got %r"
+                             % (PROPERTY_OF["order"], self.order))
+        if self.max_size > 0 and self.min_size > self.max_size:
+            raise InputError("CharacteristicLengthMin (%g mm) is larger than "
+                             "CharacteristicLengthMax (%g mm)" % (self.min_size, self.max_size))
+        if 0 < self.quality_bound < 1:
+            raise InputError("QualityBound is a radius-edge ratio bound (>= 1, e.g. 1.414; "
+                             "0 = off), got %g" % self.quality_bound)
+        return self
+
+    def to_dict(self):
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, values):
+        """Build from a dict of field values; unknown keys raise InputError."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(values) - names
+        if unknown:
+            raise InputError("unknown mesh parameter(s): %s (known: %s)"
+                             % (", ".join(sorted(unknown)), ", ".join(sorted(names))))
+        kinds = {f.name: f.type for f in dataclasses.fields(cls)}
+        converted = {}
+        for key, value in values.items():
+            kind = kinds[key]
+            try:
+                converted[key] = (bool(value) if kind in (bool, "bool") else
+                                  int(value) if kind in (int, "int") else float(value))
+            except (TypeError, ValueError):
+                raise InputError("mesh parameter %s: cannot use %r" % (key, value)) from None
+        return cls(**converted).validate()
+
+
+@dataclasses.dataclass
+class MeshResult:
+    """A mesh made by :func:`mesh_cad_shape`.
+
+    mesh:               positively oriented TetMesh (tet4 or tet10), global coordinates in mm.
+    boundary_faces:     (k, 3) corner node indices of the boundary triangles, outward CCW.
+    boundary_face_tags: (k,) CAD face index (``shape.Faces``) of each boundary triangle.
+    boundary_midnodes:  (k, 3) mid-node indices of edges (a,b), (b,c), (c,a) of each boundary
+                        triangle (tet10), or an empty (0, 3) array (tet4).
+    face_names:         ``"Face<k+1>"`` for every face of the shape.
+    stats:              the core's stats (``cli.STATS_KEYS`` and more) plus ``projected_nodes``,
+                        ``max_projection_mm``, ``seconds_total``, ``linear_deflection``.
+    tetgen:             None, or {"command", "points", "tets", "steiner_points", "seconds"} or
+                        {"command", "error"}.
+    notes:              things the user should know (e.g. a parameter the core cannot honour).
+    """
+
+    mesh: TetMesh
+    boundary_faces: np.ndarray
+    boundary_face_tags: np.ndarray
+    boundary_midnodes: np.ndarray
+    face_names: list
+    stats: dict
+    tetgen: object = None
+    notes: list = dataclasses.field(default_factory=list)
+
+    def face_nodes(self, face_tag):
+        """Sorted node indices of every boundary node on CAD face ``face_tag`` (corner and
+        mid-nodes of its boundary triangles)."""
+        sel = self.boundary_face_tags == int(face_tag)
+        parts = [self.boundary_faces[sel].reshape(-1)]
+        if len(self.boundary_midnodes):
+            parts.append(self.boundary_midnodes[sel].reshape(-1))
+        return np.unique(np.concatenate(parts))
+
+    def face_node_groups(self):
+        """``{"BspTet_Face<k>": node indices}`` for every CAD face with boundary triangles."""
+        return {FACE_GROUP_PREFIX + self.face_names[t]: self.face_nodes(t)
+                for t in np.unique(self.boundary_face_tags).tolist()}
+
+    # -- files (the worker process hands its result over through these) ---------------------
+
+    def save(self, npz_path, json_path):
+        """Arrays to ``npz_path`` (numpy, no pickle), the rest to ``json_path``."""
+        np.savez(npz_path, points=self.mesh.points, tets=self.mesh.tets,
+                 boundary_faces=self.boundary_faces, boundary_face_tags=self.boundary_face_tags,
+                 boundary_midnodes=self.boundary_midnodes)
+        with open(json_path, "w", encoding="utf-8") as f:
+            json.dump({"face_names": self.face_names, "stats": self.stats, "tetgen": self.tetgen,
+                       "notes": self.notes, "source": self.mesh.source}, f, default=_json_default)
+
+    @classmethod
+    def load(cls, npz_path, json_path):
+        with np.load(npz_path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+        with open(json_path, encoding="utf-8") as f:
+            meta = json.load(f)
+        return cls(TetMesh(arrays["points"], arrays["tets"], meta.get("source", "")),
+                   arrays["boundary_faces"].reshape(-1, 3),
+                   arrays["boundary_face_tags"].reshape(-1),
+                   arrays["boundary_midnodes"].reshape(-1, 3),
+                   meta["face_names"], meta["stats"], meta.get("tetgen"), meta.get("notes", []))
+
+
+def _json_default(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError("not JSON serialisable: %r" % type(value).__name__)
+
+
+# ------------------------------------------------------------------------------------------
+# options for the core
+# ------------------------------------------------------------------------------------------
+
+def core_option_names():
+    """Option names ``core.tetrahedralize`` accepts in this build (``core.OPTION_NAMES`` once
+    the core lists them; before that, :data:`CORE_OPTIONS_WITHOUT_QUALITY_STAGE`)."""
+    from . import core
+
+    return tuple(getattr(core, "OPTION_NAMES", CORE_OPTIONS_WITHOUT_QUALITY_STAGE))
+
+
+def core_options(params, projection=None):
+    """The ``options`` dict for ``core.tetrahedralize`` from ``params``.
+
+    Zero (automatic/off) values are left out. A non-zero CharacteristicLengthMin or
+    QualityBound that this build's core cannot honour raises InputError saying so (never
+    silently ignored). The projection hook is included only if the core takes one.
+    """
+    names = core_option_names()
+    opts = {CORE_OPTION_OF["order"]: int(params.order),
+            CORE_OPTION_OF["allow_boundary_steiner"]: bool(params.allow_boundary_steiner)}
+    if params.max_size > 0:
+        opts[CORE_OPTION_OF["max_size"]] = float(params.max_size)
+    for field in ("min_size", "quality_bound"):
+        value = getattr(params, field)
+        if value > 0:
+            key = CORE_OPTION_OF[field]
+            if key not in names:
+                raise InputError(
+                    "%s = %g needs the size control and quality refinement of the core, which "
+                    "this build does not have yet: set %s to 0"
+                    % (PROPERTY_OF[field], value, PROPERTY_OF[field]))
+            opts[key] = float(value)
+    if projection is not None and CORE_PROJECTION_OPTION in names:
+        opts[CORE_PROJECTION_OPTION] = projection
+    return opts
+
+
+# ------------------------------------------------------------------------------------------
+# the pipeline
+# ------------------------------------------------------------------------------------------
+
+def brep_copy(shape):
+    """``shape`` written as BREP text and read back: exactly the shape the worker process reads
+    from its job file (BREP text is not bit-exact for every curve, so both paths mesh this copy
+    and give identical meshes)."""
+    import Part
+
+    copy = Part.Shape()
+    copy.importBrepFromString(shape.exportBrepToString())
+    return copy
+
+
+def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_is_brep_copy=False):
+    """Mesh every solid of ``shape`` (a ``Part.Shape``) with ``params``; see the module docstring.
+
+    The shape is first replaced by its :func:`brep_copy` (same faces in the same order), unless
+    ``shape_is_brep_copy`` says it already is one (the worker, which read it from BREP).
+
+    progress: ``progress(stage, fraction)`` (fraction in [0, 1] or None), called now and then.
+    cancel:   ``cancel()`` returning True stops the run with MeshingCancelled.
+    source:   a name for messages (the document object's label, a file name).
+
+    Returns a :class:`MeshResult`. Raises InputError (not a solid, open shell, bad parameter,
+    an option the core cannot honour: the message says what and where), MeshingCancelled, or
+    InternalError (the core failed; the message says so).
+    """
+    from . import cad_tessellation, core
+    from .cad_projection import CadProjection
+
+    params = params.validate() if isinstance(params, MeshParameters) else \
+        MeshParameters.from_dict(dict(params))
+    t_start = time.perf_counter()
+    report = progress or (lambda stage, fraction: None)
+
+    def check_cancel():
+        if cancel is not None and cancel():
+            raise MeshingCancelled("cancelled: no mesh was made")
+
+    report("tessellating the CAD faces", 0.0)
+    if not shape_is_brep_copy:
+        shape = brep_copy(shape)
+    size = params.max_size if params.max_size > 0 else None
+    deflection = params.linear_deflection or \
+        cad_tessellation.default_linear_deflection(shape, size)
+    surfaces = cad_tessellation.tessellate_shape(shape, deflection, params.angular_deflection,
+                                                 source=source)
+    check_cancel()
+    projection = CadProjection(shape)
+    options = core_options(params, projection)
+
+    def core_progress(stage, fraction):
+        report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
+
+    try:
+        mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
+                                          cancel=cancel)
+    except BspTetError:
+        check_cancel()  # the core stopped because cancel() said so (whatever error it raised)
+        raise
+    check_cancel()
+
+    report("placing boundary nodes on the CAD faces", 0.87)
+    faces, tags = boundary_faces_with_tags(mesh, surfaces)
+    midnodes = boundary_midnodes(mesh, faces) if mesh.tets.shape[1] == 10 else \
+        np.zeros((0, 3), dtype=np.int64)
+    input_points = np.concatenate([s.points for s in surfaces])
+    moved, max_move = place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points,
+                                                  projection, cancel=check_cancel)
+    check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
+                                    stats.get("min_dihedral_deg"))
+    check_cancel()
+
+    report("looking for interior nodes within the CAD face tolerance", 0.9)
+    near = interior_nodes_near_faces(mesh, faces, midnodes, projection)
+    check_cancel()
+
+    stats = dict(stats)
+    stats["interior_nodes_on_faces"] = int(sum(len(v) for v in near.values()))
+    stats["projected_nodes"] = int(len(moved))
+    stats["max_projection_mm"] = float(max_move)
+    stats["linear_deflection"] = float(deflection)
+    notes = list(stats.get("notes", []))
+    if near:
+        notes.append(
+            "%d interior node(s) lie within the CAD face tolerance of a face (%s): FreeCAD's "
+            "getNodesByFace counts them as nodes of that face, so a constraint there also acts "
+            "on them (interior Steiner points the core put closer to the surface than the face "
+            "tolerance)" % (stats["interior_nodes_on_faces"],
+                            ", ".join("Face%d: %d" % (t + 1, len(v)) for t, v in near.items())))
+    tetgen = None
+    if params.compare_tetgen:
+        report("tetgen -%s on the same surface" % TETGEN_SWITCHES, 0.92)
+        tetgen = run_tetgen_comparison(surfaces)
+    stats["seconds_total"] = time.perf_counter() - t_start
+    report("done", 1.0)
+    mesh.source = source or mesh.source
+    return MeshResult(mesh, faces, tags, midnodes, shape_face_names(projection), stats, tetgen,
+                      notes)
+
+
+def shape_face_names(projection):
+    return ["Face%d" % (k + 1) for k in range(projection.face_count)]
+
+
+def run_tetgen_comparison(surfaces):
+    """``tetgen -pY`` on each surface: summed counts, or an ``error`` entry (never raises)."""
+    from .compare.tetgen_backend import run_tetgen, tetgen_available
+
+    command = "tetgen -" + TETGEN_SWITCHES
+    if not tetgen_available():
+        return {"command": command, "error": "tetgen is not installed (run scripts/setup.sh)"}
+    try:
+        runs = [run_tetgen(s, TETGEN_SWITCHES) for s in surfaces]
+    except InternalError as e:
+        return {"command": command, "error": str(e)}
+    return {"command": command,
+            "points": int(sum(len(r.mesh.points) for r in runs)),
+            "tets": int(sum(len(r.mesh.tets) for r in runs)),
+            "steiner_points": int(sum(r.steiner_points for r in runs)),
+            "seconds": float(sum(r.seconds for r in runs))}
+
+
+# ------------------------------------------------------------------------------------------
+# boundary faces and their CAD face tags
+# ------------------------------------------------------------------------------------------
+
+def boundary_faces_of(tets):
+    """(k, 3) outward boundary triangles (faces used by one tet) of positive tets (corner
+    indices), in a deterministic order (sorted by their sorted corner triple)."""
+    corners = np.asarray(tets)[:, :4]
+    faces = np.concatenate([corners[:, list(f)] for f in _OUTWARD_FACES])
+    key = np.sort(faces, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    return faces[np.sort(first[counts == 1])] if len(first) else faces[:0]
+
+
+def boundary_faces_with_tags(mesh, surfaces):
+    """Boundary triangles of ``mesh`` and the CAD face tag of each.
+
+    A boundary triangle whose three corners are exactly the corners of an input triangle takes
+    its tag (exact coordinate match: the core's boundary is the input triangulation). One with a
+    boundary Steiner point lies inside an input triangle: it takes the tag of the input triangle
+    nearest to its centroid. Raises InternalError if the surfaces carry no tags.
+    """
+    faces = boundary_faces_of(mesh.tets)
+    pts = mesh.points
+    lookup = {}
+    for s in surfaces:
+        if s.face_tags is None:
+            raise InternalError("%s: the surface has no CAD face tags" % (s.source or "surface"))
+        for tri, tag in zip(s.triangles.tolist(), s.face_tags.tolist()):
+            lookup.setdefault(_corner_key(s.points[tri]), tag)
+    tags = np.full(len(faces), -1, dtype=np.int32)
+    for k, f in enumerate(faces.tolist()):
+        tags[k] = lookup.get(_corner_key(pts[f]), -1)
+    missing = np.nonzero(tags < 0)[0]
+    if len(missing):
+        all_pts = [s.points[s.triangles] for s in surfaces]
+        all_tags = np.concatenate([s.face_tags for s in surfaces])
+        tri_pts = np.concatenate(all_pts)
+        for k in missing.tolist():
+            centroid = pts[faces[k]].mean(axis=0)
+            tags[k] = all_tags[int(np.argmin(_point_triangle_dist2(centroid, tri_pts)))]
+    return faces, tags
+
+
+def _corner_key(three_points):
+    rows = sorted(map(tuple, np.asarray(three_points, dtype=np.float64).tolist()))
+    return tuple(rows)
+
+
+def _point_triangle_dist2(p, tri):
+    """Squared distance from point ``p`` to each triangle of ``tri`` (m, 3, 3)."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    # Closest point on each triangle (Ericson, Real-Time Collision Detection 5.1.5), vectorised.
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = _dot(ab, ap), _dot(ac, ap)
+    bp = p - b
+    d3, d4 = _dot(ab, bp), _dot(ac, bp)
+    cp = p - c
+    d5, d6 = _dot(ab, cp), _dot(ac, cp)
+    va = d3 * d6 - d5 * d4
+    vb = d5 * d2 - d1 * d6
+    vc = d1 * d4 - d3 * d2
+    denom = va + vb + vc
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.where(denom != 0, vb / denom, 0.0)
+        w = np.where(denom != 0, vc / denom, 0.0)
+    q = a + ab * v[:, None] + ac * w[:, None]  # interior region
+    # vertex and edge regions
+    t_ab = np.clip(np.where(d1 - d3 != 0, d1 / np.where(d1 - d3 != 0, d1 - d3, 1), 0), 0, 1)
+    t_ac = np.clip(np.where(d2 - d6 != 0, d2 / np.where(d2 - d6 != 0, d2 - d6, 1), 0), 0, 1)
+    e_bc_num, e_bc_den = d4 - d3, (d4 - d3) + (d5 - d6)
+    t_bc = np.clip(np.where(e_bc_den != 0, e_bc_num / np.where(e_bc_den != 0, e_bc_den, 1), 0),
+                   0, 1)
+    on_ab = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
+    on_ac = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
+    on_bc = (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)
+    q = np.where(on_ab[:, None], a + ab * t_ab[:, None], q)
+    q = np.where(on_ac[:, None], a + ac * t_ac[:, None], q)
+    q = np.where(on_bc[:, None], b + (c - b) * t_bc[:, None], q)
+    q = np.where(((d1 <= 0) & (d2 <= 0))[:, None], a, q)
+    q = np.where(((d3 >= 0) & (d4 <= d3))[:, None], b, q)
+    q = np.where(((d6 >= 0) & (d5 <= d6))[:, None], c, q)
+    diff = q - p
+    return _dot(diff, diff)
+
+
+def _dot(u, v):
+    return np.einsum("ij,ij->i", u, v)
+
+
+def boundary_midnodes(mesh, faces):
+    """(k, 3) mid-node of edges (a,b), (b,c), (c,a) of each boundary triangle of a tet10 mesh."""
+    tets = mesh.tets
+    pairs = np.concatenate([tets[:, [i, j]] for i, j in _TET10_EDGES])
+    mids = tets[:, 4:10].T.reshape(-1)
+    key = np.sort(pairs, axis=1)
+    mid_of = {}
+    for (u, v), m in zip(key.tolist(), mids.tolist()):
+        mid_of[(u, v)] = m
+    out = np.empty((len(faces), 3), dtype=np.int64)
+    for k, (a, b, c) in enumerate(faces.tolist()):
+        for j, (u, v) in enumerate(((a, b), (b, c), (c, a))):
+            out[k, j] = mid_of[(u, v) if u < v else (v, u)]
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# projection of boundary nodes
+# ------------------------------------------------------------------------------------------
+
+def place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points, projection,
+                                cancel=None):
+    """Move boundary nodes that are not tessellation vertices onto their CAD face or edge.
+
+    A node's CAD faces are the tags of the boundary triangles it belongs to (for a mid-node:
+    the triangles sharing its edge); one face: projected onto it; two: onto their common CAD
+    edge (:meth:`CadProjection.to_faces`). Modifies ``mesh.points`` in place. Returns
+    ``(moved node indices, largest displacement in mm)``.
+    """
+    pts = mesh.points
+    node_tags = {}
+    input_keys = {tuple(p) for p in np.asarray(input_points).tolist()}
+    for k, (f, t) in enumerate(zip(faces.tolist(), tags.tolist())):
+        for n in f:
+            if tuple(pts[n].tolist()) not in input_keys:  # a boundary Steiner point
+                node_tags.setdefault(n, set()).add(t)
+        if len(midnodes):
+            for m in midnodes[k].tolist():
+                node_tags.setdefault(m, set()).add(t)
+    moved, max_move = [], 0.0
+    for i, (n, ts) in enumerate(sorted(node_tags.items())):
+        if cancel is not None and i % 256 == 0:
+            cancel()
+        q = np.array(projection.to_faces(pts[n], ts), dtype=np.float64)
+        d = float(np.linalg.norm(q - pts[n]))
+        if d > 0:
+            pts[n] = q
+            moved.append(n)
+            max_move = max(max_move, d)
+    return np.array(moved, dtype=np.int64), max_move
+
+
+def interior_nodes_near_faces(mesh, faces, midnodes, projection):
+    """``{face tag: [node, ...]}`` of the nodes that are not boundary nodes of a face but lie
+    within its tolerance (``FemMesh.getNodesByFace`` would return them too). Faces without such
+    nodes are left out."""
+    on_boundary = np.zeros(len(mesh.points), dtype=bool)
+    on_boundary[faces.reshape(-1)] = True
+    if len(midnodes):
+        on_boundary[midnodes.reshape(-1)] = True
+    interior = np.nonzero(~on_boundary)[0]
+    out = {}
+    if len(interior) == 0:
+        return out
+    for tag in range(projection.face_count):
+        found = projection.nodes_within_tolerance(mesh.points, tag, interior)
+        if found:
+            out[tag] = found
+    return out
+
+
+def tet10_jacobians(points, tets):
+    """Jacobian determinants of 10-node tets at their 10 nodes and the centroid: (m, 11).
+
+    Shape functions in barycentric coordinates: corner ``L_i (2 L_i - 1)``, mid-node
+    ``4 L_i L_j``; for straight edges every value equals ``det[b - a, c - a, d - a]``.
+    """
+    x = points[tets]  # (m, 10, 3)
+    edges = _TET10_EDGES
+    samples = [np.eye(4)[i] for i in range(4)]
+    samples += [0.5 * (np.eye(4)[i] + np.eye(4)[j]) for i, j in edges]
+    samples.append(np.full(4, 0.25))
+    out = np.empty((len(tets), len(samples)))
+    for s, lam in enumerate(samples):
+        grads = []
+        for i in range(4):  # dX/dL_i
+            g = (4.0 * lam[i] - 1.0) * x[:, i]
+            for e, (a, b) in enumerate(edges):
+                if a == i:
+                    g = g + 4.0 * lam[b] * x[:, 4 + e]
+                elif b == i:
+                    g = g + 4.0 * lam[a] * x[:, 4 + e]
+            grads.append(g)
+        j1, j2, j3 = grads[1] - grads[0], grads[2] - grads[0], grads[3] - grads[0]
+        out[:, s] = np.einsum("ij,ij->i", np.cross(j1, j2), j3)
+    return out
+
+
+def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_dihedral=None):
+    """Raise InternalError if a tet with a moved node is inverted or (tet10) has a non-positive
+    Jacobian determinant at a node or the centroid. The message names the tet and CAD face.
+
+    This happens when a tet next to a curved face is thinner than the distance its mid-nodes
+    move (the chord sag): flat tets (dihedral angles near 0 or 180 degrees) that only quality
+    refinement of the core removes; ``min_dihedral`` (degrees) is quoted in the message."""
+    if len(moved) == 0:
+        return
+    is_moved = np.zeros(len(mesh.points), dtype=bool)
+    is_moved[moved] = True
+    touched = np.nonzero(is_moved[mesh.tets].any(axis=1))[0]
+    t = mesh.tets[touched]
+    p = mesh.points
+    a, b, c, d = (p[t[:, i]] for i in range(4))
+    vol6 = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)
+    bad = vol6 <= 0
+    if t.shape[1] == 10:
+        bad |= (tet10_jacobians(p, t) <= 0).any(axis=1)
+    if bad.any():
+        e = int(touched[np.nonzero(bad)[0][0]])
+        node_set = set(mesh.tets[e].tolist())
+        where = sorted({face_names[g] for f, g in zip(faces.tolist(), tags.tolist())
+                        if set(f) <= node_set})
+        flat = ("; the mesh has flat elements there (minimum dihedral angle %.3g degrees), "
+                "thinner than the chord sag, which only the core's quality refinement removes "
+                "(not in this build)" % min_dihedral) if min_dihedral is not None else ""
+        raise InternalError(
+            "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
+            "first tet %d%s%s. No mesh was made. ElementOrder 1st meshes this shape (its corner "
+            "nodes are on the CAD faces)"
+            % (int(bad.sum()), e, " (at %s)" % ", ".join(where) if where else "", flat))

@@ -1,0 +1,168 @@
+"""The BspTet mesher document object: ``Fem::FemMeshObjectPython`` with proxy type
+``Fem::FemMeshBspTet`` (``/work/shared/design/freecad.md`` §4).
+
+    obj = make_mesher(doc, part, CharacteristicLengthMax=500, ElementOrder="2nd")
+    FemBspTet.run_mesher(obj)            # meshes it (mesher_tools); recompute never meshes
+
+* C++ type ``Fem::FemMeshObjectPython`` (the type FEM's Gmsh object has in 0.20/0.21; 1.x still
+  has it), so CalculiX, Z88 and Mystran take the object as the analysis mesh. The proxy's
+  ``Type`` is ``Fem::FemMeshBspTet``: FEM never mistakes it for Gmsh.
+* ``Part`` (App::PropertyLink): the solid the mesh is made from. FEM's writers read
+  ``mesh_obj.Part`` when there is no ``Shape``.
+* Parameters mean what FemMeshGmsh's mean where the names are the same
+  (``CharacteristicLengthMax``/``Min``: 0 = automatic/none; ``ElementOrder`` "1st"/"2nd").
+* Results (read-only in the property editor) are set by ``mesher_tools.apply_result``.
+* Saved files store ``module="FemBspTet.mesher_object" class="MeshBspTet"``: never rename them.
+  Properties are added only if missing, from ``__init__`` and from ``onDocumentRestored`` (files
+  of older versions gain new properties with their defaults).
+"""
+
+from .errors import InputError
+
+#: Proxy type (``femutils.type_of_obj``).
+PROXY_TYPE = "Fem::FemMeshBspTet"
+#: C++ type of the document object.
+OBJECT_TYPE = "Fem::FemMeshObjectPython"
+
+PARAMS_GROUP = "BspTet Mesh Params"
+RESULTS_GROUP = "BspTet Mesh Results"
+
+#: (type, name, group, tooltip, default) of every parameter property.
+PARAMETER_PROPERTIES = (
+    ("App::PropertyLink", "Part", "FEM Mesh", "The solid (Part) the mesh is made from", None),
+    ("App::PropertyLength", "CharacteristicLengthMax", PARAMS_GROUP,
+     "Maximum element size (0 = automatic). Sets the surface tessellation; volume size control "
+     "needs the core's quality stage", 0.0),
+    ("App::PropertyLength", "CharacteristicLengthMin", PARAMS_GROUP,
+     "Minimum element size (0 = none). Needs the core's quality stage", 0.0),
+    ("App::PropertyEnumeration", "ElementOrder", PARAMS_GROUP,
+     "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
+     ("1st", "2nd")),
+    ("App::PropertyLength", "LinearDeflection", PARAMS_GROUP,
+     "Largest distance between the surface triangles and the CAD faces (0 = automatic: "
+     "min(h/10, diagonal/200) with a maximum size h, else diagonal/500)", 0.0),
+    ("App::PropertyAngle", "AngularDeflection", PARAMS_GROUP,
+     "Largest angle between the normals of neighbouring surface triangles", 28.64788975654116),
+    ("App::PropertyFloat", "QualityBound", PARAMS_GROUP,
+     "Radius-edge ratio bound of quality refinement (0 = off; e.g. 1.414). Needs the core's "
+     "quality stage", 0.0),
+    ("App::PropertyBool", "AllowBoundarySteiner", PARAMS_GROUP,
+     "Allow Steiner points on the surface (placed on the CAD faces)", False),
+    ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
+     "Make a node group per CAD face (BspTet_Face1, ...)", False),
+    ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
+     "Also run tetgen -pY on the same surface and show its counts", True),
+)
+
+#: (type, name, tooltip) of every read-only result property.
+RESULT_PROPERTIES = (
+    ("App::PropertyString", "MeshStatus", "Outcome of the last meshing run"),
+    ("App::PropertyInteger", "Nodes", "Nodes of the mesh"),
+    ("App::PropertyInteger", "Tetrahedra", "Tetrahedra of the mesh"),
+    ("App::PropertyInteger", "SteinerPoints", "Points the mesher added to the surface vertices"),
+    ("App::PropertyInteger", "BoundarySteinerPoints", "Steiner points on the surface"),
+    ("App::PropertyFloat", "MinDihedralAngle", "Smallest dihedral angle (degrees)"),
+    ("App::PropertyFloat", "MaxRadiusEdgeRatio", "Largest radius-edge ratio"),
+    ("App::PropertyFloat", "MeshingTime", "Seconds of the last run (tessellation to FemMesh)"),
+    ("App::PropertyStringList", "MeshNotes", "What the mesher could not do as asked, warnings"),
+    ("App::PropertyString", "TetGenCommand", "The TetGen run of the comparison"),
+    ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the same surface"),
+    ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the same surface"),
+    ("App::PropertyInteger", "TetGenSteinerPoints", "TetGen's Steiner points"),
+    ("App::PropertyFloat", "TetGenTime", "TetGen's seconds"),
+)
+
+
+def add_properties(obj):
+    """Add every missing property of the mesher object (also used to upgrade old files)."""
+    existing = set(obj.PropertiesList)
+    for kind, name, group, tip, default in PARAMETER_PROPERTIES:
+        if name in existing:
+            continue
+        obj.addProperty(kind, name, group, tip)
+        if kind == "App::PropertyEnumeration":
+            setattr(obj, name, list(default))
+            setattr(obj, name, default[-1])
+        elif default is not None:
+            setattr(obj, name, default)
+    for kind, name, tip in RESULT_PROPERTIES:
+        if name not in existing:
+            obj.addProperty(kind, name, RESULTS_GROUP, tip)
+        obj.setEditorMode(name, 1)  # read-only in the property editor
+
+
+class MeshBspTet:
+    """Proxy of the mesher object. Holds no state of its own (everything is in properties)."""
+
+    Type = PROXY_TYPE
+
+    def __init__(self, obj):
+        obj.Proxy = self
+        add_properties(obj)
+
+    def onDocumentRestored(self, obj):
+        add_properties(obj)
+
+    def execute(self, obj):
+        """Recompute never meshes (as FEM's Gmsh object): meshing is an explicit action."""
+        return None
+
+    # FreeCAD 0.20 calls __getstate__/__setstate__, newer versions dumps/loads: both, no state.
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+
+def is_mesher(obj):
+    """True if ``obj`` is a BspTet mesher object."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == PROXY_TYPE
+
+
+def make_mesher(doc, part=None, name="MeshBspTet", **properties):
+    """Create a BspTet mesher object in ``doc`` for ``part`` (not meshed yet).
+
+    doc:        a FreeCAD document.
+    part:       the document object with the solid (``Part::Feature`` and the like), or None.
+    name:       the object's name (FreeCAD makes it unique).
+    properties: property values, e.g. ``CharacteristicLengthMax=500, ElementOrder="1st"``; the
+                preferences (Edit > Preferences > FEM > BspTet) give the others.
+
+    Returns the object. Raises InputError for an unknown property name or a bad value.
+    """
+    from .freecad_env import import_freecad
+    from .preferences import object_defaults
+
+    freecad = import_freecad()
+    import Fem  # noqa: F401  (registers the Fem:: document object types)
+
+    known = {p[1] for p in PARAMETER_PROPERTIES}
+    unknown = set(properties) - known
+    if unknown:
+        raise InputError("unknown mesher propert%s %s; the parameters are %s"
+                         % ("y" if len(unknown) == 1 else "ies", ", ".join(sorted(unknown)),
+                            ", ".join(sorted(known - {"Part"}))))
+    obj = doc.addObject(OBJECT_TYPE, name)
+    MeshBspTet(obj)
+    values = dict(object_defaults())
+    values.update(properties)
+    if part is not None:
+        values["Part"] = part
+    try:
+        for key, value in values.items():
+            setattr(obj, key, value)
+    except Exception as e:
+        doc.removeObject(obj.Name)
+        raise InputError("mesher property %s: %s" % (key, e)) from None
+    if freecad.GuiUp:
+        from .view_provider import VPMeshBspTet
+
+        VPMeshBspTet(obj.ViewObject)
+    return obj

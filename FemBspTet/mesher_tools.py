@@ -1,0 +1,143 @@
+"""Meshing with the BspTet mesher object, and what scripts call (``import FemBspTet``):
+
+    obj = FemBspTet.make_mesher(doc, part, CharacteristicLengthMax=500)
+    FemBspTet.run_mesher(obj)                       # synchronous; raises on failure
+    femmesh = FemBspTet.mesh_shape(shape, max_size=500, order=2)
+    FemBspTet.export_mesh(obj, "part.inp")          # .inp .unv .vtk .vtu .med .z88
+
+A failed run leaves the object's previous ``FemMesh`` as it was; only ``MeshStatus`` says what
+went wrong. The task panel runs the same pipeline in a worker process
+(:mod:`FemBspTet.mesh_worker`) and hands the result to :func:`apply_result` on the GUI thread.
+"""
+
+import math
+
+from .errors import InputError
+from .mesh_pipeline import PROPERTY_OF, MeshParameters, mesh_cad_shape
+
+#: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
+EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
+
+
+def parameters_from_object(obj):
+    """:class:`MeshParameters` from the mesher object's properties (validated)."""
+    return MeshParameters(
+        max_size=float(obj.CharacteristicLengthMax.Value),
+        min_size=float(obj.CharacteristicLengthMin.Value),
+        order=1 if obj.ElementOrder == "1st" else 2,
+        linear_deflection=float(obj.LinearDeflection.Value),
+        angular_deflection=math.radians(float(obj.AngularDeflection.Value)),
+        quality_bound=float(obj.QualityBound),
+        allow_boundary_steiner=bool(obj.AllowBoundarySteiner),
+        face_groups=bool(obj.FaceGroups),
+        compare_tetgen=bool(obj.CompareWithTetGen),
+    ).validate()
+
+
+def shape_of(obj):
+    """The shape to mesh: ``obj.Part.Shape``. InputError if there is none."""
+    part = getattr(obj, "Part", None)
+    if part is None:
+        raise InputError("no Part is set: select the solid to mesh (property Part)",
+                         where=obj.Label)
+    shape = getattr(part, "Shape", None)
+    if shape is None or shape.isNull():
+        raise InputError("%s has no shape to mesh" % part.Label, where=obj.Label)
+    return shape
+
+
+def run_mesher(obj, progress=None, cancel=None):
+    """Mesh the mesher object ``obj`` now, in this thread. Returns the MeshResult.
+
+    progress(stage, fraction) and cancel() as in :func:`mesh_pipeline.mesh_cad_shape`.
+    On failure the previous FemMesh stays, ``obj.MeshStatus`` says why, and the error
+    (InputError, MeshingCancelled, InternalError; the message names the object) is raised.
+    """
+    try:
+        params = parameters_from_object(obj)
+        result = mesh_cad_shape(shape_of(obj), params, progress=progress, cancel=cancel,
+                                source=obj.Label)
+    except Exception as e:  # every failure is recorded; the error itself goes on up
+        record_failure(obj, e)
+        raise
+    apply_result(obj, result)
+    return result
+
+
+def record_failure(obj, error):
+    """Say in ``obj.MeshStatus`` why the last run failed (the mesh itself is left alone)."""
+    obj.MeshStatus = "failed: %s" % error
+
+
+def femmesh_of(result, face_groups):
+    """The ``Fem.FemMesh`` of a MeshResult (SMESH conventions; node groups per CAD face if
+    ``face_groups``)."""
+    from .freecad_export import tetmesh_to_femmesh
+
+    return tetmesh_to_femmesh(result.mesh, result.face_node_groups() if face_groups else None)
+
+
+def apply_result(obj, result, femmesh=None):
+    """Set ``obj.FemMesh`` and the result properties from ``result`` (a MeshResult). Call on the
+    GUI thread when the GUI is up. ``femmesh`` may be given if already built."""
+    fem = femmesh if femmesh is not None else femmesh_of(result, bool(obj.FaceGroups))
+    st = result.stats
+    obj.FemMesh = fem
+    obj.Nodes = int(len(result.mesh.points))
+    obj.Tetrahedra = int(len(result.mesh.tets))
+    obj.SteinerPoints = int(st.get("steiner_points", 0))
+    obj.BoundarySteinerPoints = int(st.get("boundary_steiner_points", 0))
+    obj.MinDihedralAngle = float(st.get("min_dihedral_deg") or 0.0)
+    obj.MaxRadiusEdgeRatio = float(st.get("max_radius_edge_ratio") or 0.0)
+    obj.MeshingTime = float(st.get("seconds_total") or 0.0)
+    obj.MeshNotes = [str(n) for n in result.notes]
+    tg = result.tetgen or {}
+    obj.TetGenCommand = str(tg.get("command", "")) + (
+        " failed: %s" % tg["error"] if "error" in tg else "")
+    obj.TetGenNodes = int(tg.get("points", 0))
+    obj.TetGenTetrahedra = int(tg.get("tets", 0))
+    obj.TetGenSteinerPoints = int(tg.get("steiner_points", 0))
+    obj.TetGenTime = float(tg.get("seconds", 0.0))
+    obj.MeshStatus = "meshed: %d nodes, %d %s" % (
+        obj.Nodes, obj.Tetrahedra, "tet10" if result.mesh.tets.shape[1] == 10 else "tet4")
+
+
+def mesh_shape(shape, **options):
+    """Mesh a ``Part.Shape`` and return a ``Fem.FemMesh`` (SMESH conventions).
+
+    options: MeshParameters fields (``max_size``, ``min_size``, ``order``,
+    ``linear_deflection``, ``angular_deflection`` in radians, ``quality_bound``,
+    ``allow_boundary_steiner``, ``face_groups``) or the object's property names
+    (``CharacteristicLengthMax``, ``ElementOrder`` "1st"/"2nd", ``AngularDeflection`` in
+    degrees, ...). Raises InputError / InternalError with a message.
+    """
+    params = MeshParameters(compare_tetgen=False).to_dict()
+    field_of = {prop: field for field, prop in PROPERTY_OF.items()}
+    for key, value in options.items():
+        field = field_of.get(key, key)
+        if key == "ElementOrder":
+            value = {"1st": 1, "2nd": 2}.get(value, value)
+        if key == "AngularDeflection":
+            value = math.radians(float(value))
+        params[field] = value
+    params = MeshParameters.from_dict(params)
+    result = mesh_cad_shape(shape, params)
+    return femmesh_of(result, params.face_groups)
+
+
+def export_mesh(obj, path):
+    """Write the mesh of ``obj`` (any FEM mesh object) to ``path`` with FreeCAD's writer for its
+    extension: .inp (CalculiX C3D4/C3D10), .unv, .vtk, .vtu, .med, .z88. Returns the path.
+    Written to a temporary file and renamed: a failure leaves no partial file."""
+    import os
+
+    from .freecad_export import write_femmesh
+
+    ext = os.path.splitext(os.fspath(path))[1].lower()
+    if ext not in EXPORT_FORMATS:
+        raise InputError("cannot export a mesh as %r; use one of %s"
+                         % (ext or "(no extension)", " ".join(EXPORT_FORMATS)), where=path)
+    fem = obj.FemMesh
+    if fem.VolumeCount == 0:
+        raise InputError("has no volume mesh to export: mesh it first", where=obj.Label)
+    return write_femmesh(path, fem)

@@ -1,0 +1,86 @@
+"""View provider of the BspTet mesher object (on FreeCAD's ``FemGui::ViewProviderFemMeshPython``).
+
+Double click or Edit opens the task panel (:mod:`FemBspTet.task_panel`). Saved files store
+``module="FemBspTet.view_provider" class="VPMeshBspTet"`` in GuiDocument.xml: never rename.
+Holds no state that is saved (both serialisation pairs return None).
+"""
+
+import os
+
+#: Icon of the mesher object and of its command.
+ICON_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                         "resources", "icons", "FEM_MeshBspTetFromShape.svg")
+
+
+class VPMeshBspTet:
+    def __init__(self, vobj):
+        vobj.Proxy = self
+        self.ViewObject = vobj
+        self.Object = vobj.Object
+        self.task_panel = None
+
+    def attach(self, vobj):
+        self.ViewObject = vobj
+        self.Object = vobj.Object
+        self.task_panel = None
+
+    def getIcon(self):
+        return ICON_PATH
+
+    def updateData(self, obj, prop):
+        return
+
+    def onChanged(self, vobj, prop):
+        return
+
+    def claimChildren(self):
+        return []
+
+    def setEdit(self, vobj, mode=0):
+        """Open the task panel (edit mode 0 only; other modes, e.g. Transform, are FreeCAD's)."""
+        if mode != 0:
+            return None
+        import FreeCADGui
+
+        from .task_panel import TaskPanelMeshBspTet
+
+        if FreeCADGui.Control.activeDialog():
+            FreeCADGui.Control.closeDialog()
+        vobj.show()
+        self.task_panel = TaskPanelMeshBspTet(vobj.Object)  # for scripts and tests; not saved
+        FreeCADGui.Control.showDialog(self.task_panel)
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        if mode != 0:
+            return None
+        import FreeCADGui
+
+        FreeCADGui.Control.closeDialog()
+        self.task_panel = None
+        return True
+
+    def doubleClicked(self, vobj):
+        import FreeCAD
+        import FreeCADGui
+
+        gui_doc = FreeCADGui.getDocument(vobj.Object.Document)
+        if gui_doc.getInEdit():
+            FreeCAD.Console.PrintWarning(
+                "FemBspTet: another object is being edited; close its task panel first\n")
+            return True
+        gui_doc.setEdit(vobj.Object.Name)
+        return True
+
+    # FreeCAD 0.20 calls __getstate__/__setstate__, newer versions dumps/loads: both, no state.
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None

@@ -1,0 +1,86 @@
+#!/usr/bin/python3
+"""Every CAD file of a folder through the FreeCAD mesher pipeline, each in a worker process with a
+time limit: either a mesh (nodes, tets, seconds, boundary nodes put on the CAD) or the message the
+user would see. Usage:
+
+    bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--timeout S] [--markdown F]
+
+Default folder: tests/data/cad. Prints one row per file.
+"""
+
+import argparse
+import os
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from FemBspTet.cad_tessellation import CAD_FORMATS  # noqa: E402
+from FemBspTet.errors import BspTetError  # noqa: E402
+from FemBspTet.freecad_env import import_freecad  # noqa: E402
+from FemBspTet.mesh_pipeline import MeshParameters  # noqa: E402
+from FemBspTet.mesh_worker import MeshJob  # noqa: E402
+
+
+def cad_files(args):
+    out = []
+    for a in args:
+        if os.path.isdir(a):
+            out += sorted(os.path.join(a, f) for f in os.listdir(a)
+                          if os.path.splitext(f)[1].lower() in CAD_FORMATS)
+        else:
+            out.append(a)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("inputs", nargs="*", default=[os.path.join(ROOT, "tests", "data", "cad")])
+    ap.add_argument("--order", type=int, choices=(1, 2), default=1)
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--markdown", default=None)
+    args = ap.parse_args()
+    import_freecad()
+    import Part
+
+    rows = [("file", "solids", "faces", "result", "nodes", "tets", "seconds")]
+    for path in cad_files(args.inputs):
+        name = os.path.basename(path)
+        t0 = time.perf_counter()
+        try:
+            shape = Part.read(path)
+        except Exception as e:
+            rows.append((name, "-", "-", "unreadable: %s" % e, "", "", ""))
+            print(" | ".join(str(c) for c in rows[-1]), flush=True)
+            continue
+        job = MeshJob(shape, MeshParameters(order=args.order, compare_tetgen=False),
+                      source=name, python="/usr/bin/python3")
+        job.start()
+        if not job.wait(args.timeout):
+            job.cancel()
+            rows.append((name, len(shape.Solids), len(shape.Faces),
+                         "stopped after %g s" % args.timeout, "", "", ""))
+            print(" | ".join(str(c) for c in rows[-1]), flush=True)
+            continue
+        try:
+            r = job.result()
+            rows.append((name, len(shape.Solids), len(shape.Faces), "ok", len(r.mesh.points),
+                         len(r.mesh.tets), "%.1f" % (time.perf_counter() - t0)))
+        except BspTetError as e:
+            msg = str(e).replace("\n", " ")
+            rows.append((name, len(shape.Solids), len(shape.Faces),
+                         "%s: %s" % (type(e).__name__, msg[:240]), "", "",
+                         "%.1f" % (time.perf_counter() - t0)))
+        print(" | ".join(str(c) for c in rows[-1]), flush=True)
+    if args.markdown:
+        with open(args.markdown, "w") as f:
+            f.write("| " + " | ".join(rows[0]) + " |\n|" + "---|" * len(rows[0]) + "\n")
+            for r in rows[1:]:
+                f.write("| " + " | ".join(str(c) for c in r) + " |\n")
+    ok = sum(1 for r in rows[1:] if r[3] == "ok")
+    print("%d of %d files meshed (order %d)" % (ok, len(rows) - 1, args.order))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,208 @@
+# Runs INSIDE FreeCAD's GUI (offscreen):
+#     QT_QPA_PLATFORM=offscreen freecad gui_offscreen_session.py
+# Driven by tests/test_gui_offscreen.py, which gives it a throw-away HOME with the checkout
+# installed as a Mod (~/.local/share/FreeCAD/Mod/FemBspTet) and reads the facts it records
+# (JSON, path in FEMBSPTET_GUI_OUT). It records what it sees and never decides pass/fail itself; every step is
+# guarded so that one failure still reports the others. Ends with os._exit (FreeCAD's event loop
+# would otherwise keep running).
+import json
+import os
+import sys
+import tempfile
+import time
+import traceback
+import zipfile
+
+facts = {"errors": []}
+out_path = os.environ.get("FEMBSPTET_GUI_OUT", "/tmp/fembsptet_gui_out.json")
+
+
+def step(name):
+    def wrap(fn):
+        try:
+            fn()
+        except Exception:
+            facts["errors"].append("%s: %s" % (name, traceback.format_exc()))
+        return fn
+    return wrap
+
+
+try:
+    import FreeCAD
+    import FreeCADGui
+    from PySide import QtGui
+
+    facts["gui_up"] = bool(FreeCAD.GuiUp)
+
+    @step("workbench and command")
+    def _():
+        facts["workbench_registered"] = "FemBspTetWorkbench" in FreeCADGui.listWorkbenches()
+        facts["command_registered"] = "FEM_MeshBspTetFromShape" in FreeCADGui.listCommands()
+        FreeCADGui.activateWorkbench("FemWorkbench")
+        mw = FreeCADGui.getMainWindow()
+        bars = {t.windowTitle(): [a.objectName() or a.text() for a in t.actions()]
+                for t in mw.findChildren(QtGui.QToolBar)}
+        facts["fem_toolbars"] = sorted(bars)
+        facts["bsptet_toolbar_in_fem"] = bars.get("BspTet")
+        from FemBspTet import commands
+
+        for _ in range(5):
+            QtGui.QApplication.processEvents()
+        menu = commands.fem_mesh_menu()
+        facts["fem_mesh_menu_entries"] = ([a.objectName() for a in menu.actions()]
+                                          if menu is not None else None)
+        FreeCADGui.activateWorkbench("FemBspTetWorkbench")
+        bars = {t.windowTitle(): [a.objectName() or a.text() for a in t.actions()]
+                for t in mw.findChildren(QtGui.QToolBar) if t.isVisible()}
+        facts["own_workbench_toolbar"] = bars.get("BspTet")
+        FreeCADGui.activateWorkbench("FemWorkbench")
+
+    import ObjectsFem
+    import FemGui
+    import Part
+
+    doc = FreeCAD.newDocument("GuiTest")
+    block = doc.addObject("Part::Feature", "Block")
+    block.Shape = Part.makeBox(40, 20, 10).cut(
+        Part.makeCylinder(5, 10, FreeCAD.Vector(20, 10, 0)))
+    doc.recompute()
+    analysis = ObjectsFem.makeAnalysis(doc, "Analysis")
+    FemGui.setActiveAnalysis(analysis)
+    state = {}
+
+    @step("command creates the object")
+    def _():
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.Selection.addSelection(block)
+        from FemBspTet.commands import CommandMeshBspTetFromShape
+
+        facts["command_active_with_selection"] = CommandMeshBspTetFromShape().IsActive()
+        FreeCADGui.Selection.clearSelection()
+        facts["command_active_without_selection"] = CommandMeshBspTetFromShape().IsActive()
+        FreeCADGui.Selection.addSelection(block)
+        FreeCADGui.runCommand("FEM_MeshBspTetFromShape")
+        obj = doc.getObject("MeshBspTet")
+        state["obj"] = obj
+        facts["object_type"] = obj.TypeId
+        facts["proxy_type"] = obj.Proxy.Type
+        facts["part_link"] = obj.Part.Name
+        facts["view_provider"] = type(obj.ViewObject.Proxy).__name__
+        facts["in_analysis"] = obj in analysis.Group
+        import __main__
+
+        facts["created_through_doCommand"] = getattr(__main__, "_mesh", None) is obj
+        facts["task_dialog_open_after_command"] = bool(FreeCADGui.Control.activeDialog())
+        FreeCADGui.Control.closeDialog()
+        FreeCADGui.ActiveDocument.resetEdit()
+
+    @step("task panel meshes")
+    def _():
+        from FemBspTet.task_panel import TaskPanelMeshBspTet
+
+        obj = state["obj"]
+        obj.ElementOrder = "1st"
+        FreeCADGui.ActiveDocument.setEdit(obj.Name)
+        tp = obj.ViewObject.Proxy.task_panel
+        facts["panel_is_ours"] = isinstance(tp, TaskPanelMeshBspTet)
+        state["panel"] = tp
+        t0 = time.monotonic()
+        facts["apply_started"] = tp.start_meshing()
+        facts["gui_responsive_while_meshing"] = tp.running  # start returned before the end
+        facts["panel_finished"] = tp.wait(120)
+        facts["panel_seconds"] = time.monotonic() - t0
+        facts["panel_status"] = tp.status.text()
+        facts["panel_stats"] = tp.stats.text()
+        facts["panel_table"] = tp.comparison_table()
+        facts["panel_progress"] = tp.progress.value()
+        facts["panel_error"] = str(tp.last_error) if tp.last_error else None
+        facts["nodes_after_mesh"] = obj.FemMesh.NodeCount
+        facts["tets_after_mesh"] = obj.FemMesh.VolumeCount
+        facts["result_nodes_property"] = obj.Nodes
+        facts["tetgen_tets_property"] = obj.TetGenTetrahedra
+        facts["mesh_status"] = obj.MeshStatus
+        shot = os.environ.get("FEMBSPTET_GUI_SCREENSHOT")
+        if shot:
+            tp.form.resize(420, 760)
+            tp.form.grab().save(shot)
+
+    @step("stop keeps the previous mesh")
+    def _():
+        obj, tp = state["obj"], state["panel"]
+        before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.MeshStatus)
+        tp.sb_deflection.setValue(0.05)  # another mesh, were it kept
+        facts["restart_started"] = tp.start_meshing()
+        job = tp.job
+        facts["running_before_stop"] = tp.running
+        tp.stop_meshing()
+        facts["worker_ended_after_stop"] = job._proc.poll() is not None
+        facts["running_after_stop"] = tp.running
+        QtGui.QApplication.processEvents()
+        after = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.MeshStatus)
+        facts["mesh_kept_after_stop"] = before == after
+        facts["status_after_stop"] = tp.status.text()
+
+    @step("failure keeps the previous mesh")
+    def _():
+        obj, tp = state["obj"], state["panel"]
+        shell = doc.addObject("Part::Feature", "OpenShell")
+        shell.Shape = Part.Shell(Part.makeBox(5, 5, 5).Faces[:5])
+        doc.recompute()
+        before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount)
+        obj.Part = shell
+        tp.sb_deflection.setValue(0.0)
+        tp.start_meshing()
+        tp.wait(120)
+        facts["failure_error"] = str(tp.last_error)
+        facts["failure_status_property"] = obj.MeshStatus
+        facts["mesh_kept_after_failure"] = before == (obj.FemMesh.NodeCount,
+                                                      obj.FemMesh.VolumeCount)
+        obj.Part = block
+        doc.removeObject("OpenShell")
+
+    @step("dialog buttons")
+    def _():
+        tp = state["panel"]
+        facts["ok_closes"] = tp.accept()
+        facts["dialog_open_after_ok"] = bool(FreeCADGui.Control.activeDialog())
+
+    @step("double click opens the task panel")
+    def _():
+        obj = state["obj"]
+        obj.ViewObject.Proxy.doubleClicked(obj.ViewObject)
+        facts["dialog_open_after_double_click"] = bool(FreeCADGui.Control.activeDialog())
+        FreeCADGui.Control.closeDialog()
+        FreeCADGui.ActiveDocument.resetEdit()
+
+    @step("save and reload")
+    def _():
+        obj = state["obj"]
+        nodes = obj.FemMesh.NodeCount
+        path = os.path.join(tempfile.mkdtemp(prefix="fembsptet_gui_"), "gui_test.FCStd")
+        doc.saveAs(path)
+        gui_xml = zipfile.ZipFile(path).read("GuiDocument.xml").decode()
+        facts["gui_document_has_vp_module"] = "FemBspTet.view_provider" in gui_xml
+        FreeCAD.closeDocument(doc.Name)
+        doc2 = FreeCAD.openDocument(path)
+        o2 = doc2.getObject("MeshBspTet")
+        facts["reloaded_nodes_equal"] = o2.FemMesh.NodeCount == nodes and nodes > 0
+        facts["reloaded_proxy_type"] = getattr(o2.Proxy, "Type", None)
+        facts["reloaded_view_provider"] = type(o2.ViewObject.Proxy).__name__
+        facts["reloaded_part"] = o2.Part.Name if o2.Part else None
+        FreeCAD.closeDocument(doc2.Name)
+
+    @step("preferences page")
+    def _():
+        import FemBspTet
+
+        ui = os.path.join(os.path.dirname(os.path.dirname(FemBspTet.__file__)), "resources",
+                          "ui", "PreferencesBspTet.ui")
+        w = FreeCADGui.PySideUic.loadUi(ui)
+        sb = w.findChild(QtGui.QDoubleSpinBox, "sb_angular_deflection")
+        facts["prefs_spinbox_class"] = sb.metaObject().className() if sb else None
+except Exception:
+    facts["errors"].append("session: " + traceback.format_exc())
+finally:
+    with open(out_path, "w") as f:
+        json.dump(facts, f, indent=1, default=str)
+    sys.stdout.flush()
+    os._exit(0)

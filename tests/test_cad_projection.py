@@ -1,0 +1,163 @@
+"""The OpenCASCADE projection hook on its own (FemBspTet.cad_projection): projected points lie on
+the CAD face within its tolerance, so that FemMesh.getNodesByFace finds them; points between two
+faces go onto their common CAD edge and are found by both faces and by the edge.
+
+The shapes are moved by a non-trivial placement so that global coordinates are exercised.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from FemBspTet.errors import InputError
+from FemBspTet.freecad_env import freecad_available
+
+if not freecad_available():
+    pytest.skip("FreeCAD (Debian package freecad-python3) is not available",
+                allow_module_level=True)
+
+
+@pytest.fixture(scope="module")
+def fc():
+    from FemBspTet.freecad_env import import_freecad
+
+    freecad = import_freecad()
+    import Fem
+    import Part
+
+    return freecad, Part, Fem
+
+
+def placed(fc, shape):
+    freecad, _, _ = fc
+    shape = shape.copy()
+    shape.Placement = freecad.Placement(freecad.Vector(3.5, -7.25, 11.0),
+                                        freecad.Rotation(freecad.Vector(1, 2, 3), 37.0))
+    return shape
+
+
+def plate_with_hole(fc):
+    freecad, Part, _ = fc
+    return placed(fc, Part.makeBox(60, 40, 8).cut(
+        Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0))))
+
+
+def face_index(shape, kind):
+    return [k for k, f in enumerate(shape.Faces) if type(f.Surface).__name__ == kind]
+
+
+def nodes_found(fc, points, shape_part):
+    """Ids (1-based) of ``points`` that FemMesh.getNodesBy{Face,Edge} returns for shape_part."""
+    _, _, Fem = fc
+    fem = Fem.FemMesh()
+    for i, p in enumerate(points, start=1):
+        fem.addNode(float(p[0]), float(p[1]), float(p[2]), i)
+    if shape_part.ShapeType == "Face":
+        return set(fem.getNodesByFace(shape_part))
+    return set(fem.getNodesByEdge(shape_part))
+
+
+def perturbed_points_near(face, n, offset, seed):
+    """``n`` points of ``face`` (from its own parameter domain) moved ``offset`` mm off it along
+    random directions."""
+    rng = np.random.default_rng(seed)
+    u0, u1, v0, v1 = face.ParameterRange
+    pts = []
+    while len(pts) < n:
+        u, v = rng.uniform(u0, u1), rng.uniform(v0, v1)
+        if not face.isPartOfDomain(u, v):
+            continue
+        p = face.Surface.value(u, v)
+        d = rng.normal(size=3)
+        d *= offset / np.linalg.norm(d)
+        pts.append((p.x + d[0], p.y + d[1], p.z + d[2]))
+    return pts
+
+
+@pytest.mark.parametrize("kind", ["Cylinder", "Plane"])
+def test_projected_points_are_found_by_get_nodes_by_face(fc, kind):
+    from FemBspTet.cad_projection import CadProjection
+
+    shape = plate_with_hole(fc)
+    proj = CadProjection(shape)
+    tag = face_index(shape, kind)[0]
+    face = shape.Faces[tag]
+    raw = perturbed_points_near(face, 40, 0.3, seed=tag)
+    # the raw points are 0.3 mm off: getNodesByFace finds none of them
+    assert nodes_found(fc, raw, face) == set()
+    projected = [proj(p, tag) for p in raw]
+    for q in projected:
+        assert proj.distance_to_face(q, tag) < proj.face_tolerance(tag)
+    assert nodes_found(fc, projected, face) == set(range(1, len(projected) + 1))
+    # idempotent: a projected point stays where it is
+    for q in projected:
+        again = proj(q, tag)
+        assert math.dist(again, q) <= 1e-9
+
+
+def test_points_outside_the_trimmed_face_go_to_its_boundary(fc):
+    """A point whose nearest point on the untrimmed plane lies in the hole: the nearest point of
+    the bounded face is on the hole's edge, still on the face."""
+    from FemBspTet.cad_projection import CadProjection
+
+    freecad, Part, _ = fc
+    shape = Part.makeBox(60, 40, 8).cut(Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0)))
+    proj = CadProjection(shape)
+    top = [k for k in face_index(shape, "Plane") if abs(shape.Faces[k].CenterOfMass.z - 8) < 1e-9]
+    assert len(top) == 1
+    q = proj((33.0, 20.0, 9.0), top[0])  # above the hole, 3 mm from its axis
+    assert proj.distance_to_face(q, top[0]) < proj.face_tolerance(top[0])
+    assert abs(math.hypot(q[0] - 30, q[1] - 20) - 10) < 1e-9 and abs(q[2] - 8) < 1e-12
+
+
+def test_point_between_two_faces_goes_onto_their_common_edge(fc):
+    from FemBspTet.cad_projection import CadProjection
+
+    shape = plate_with_hole(fc)
+    proj = CadProjection(shape)
+    cyl = face_index(shape, "Cylinder")[0]
+    planes = [k for k in face_index(shape, "Plane") if proj.common_edges(cyl, k)]
+    assert len(planes) == 2  # top and bottom share a circle with the hole
+    for k in planes:
+        edge = proj.common_edges(cyl, k)[0]
+        t0, t1 = edge.ParameterRange
+        raw = []
+        centre = shape.Faces[cyl].CenterOfMass  # on the hole's axis, half-way up
+        for j in range(12):
+            p = edge.valueAt(t0 + (t1 - t0) * (j + 0.5) / 12)
+            d = centre - p
+            d.normalize()
+            raw.append((p.x + 0.3 * d.x, p.y + 0.3 * d.y, p.z + 0.3 * d.z))  # off both faces
+        projected = [proj.to_faces(p, {cyl, k}) for p in raw]
+        ids = set(range(1, len(projected) + 1))
+        assert nodes_found(fc, projected, shape.Faces[cyl]) == ids
+        assert nodes_found(fc, projected, shape.Faces[k]) == ids
+        assert nodes_found(fc, projected, edge) == ids
+        # projecting onto one face only is not enough for the other face
+        one_face = [proj.to_face(p, cyl) for p in raw]
+        assert nodes_found(fc, one_face, shape.Faces[k]) != ids
+
+
+def test_three_faces_meet_at_a_vertex(fc):
+    from FemBspTet.cad_projection import CadProjection
+
+    _, Part, _ = fc
+    box = Part.makeBox(2, 3, 4)
+    proj = CadProjection(box)
+    corner_faces = [k for k, f in enumerate(box.Faces)
+                    if any(v.Point.Length == 0 for v in f.Vertexes)]
+    assert len(corner_faces) == 3
+    assert proj.to_faces((0.1, -0.2, 0.05), corner_faces) == (0.0, 0.0, 0.0)
+
+
+def test_bad_face_tag_is_an_input_error(fc):
+    from FemBspTet.cad_projection import CadProjection
+
+    _, Part, _ = fc
+    proj = CadProjection(Part.makeBox(1, 1, 1))
+    with pytest.raises(InputError, match="face tag 6 is not a face"):
+        proj((0, 0, 0), 6)
+    with pytest.raises(InputError, match="no common CAD edge or vertex"):
+        # Face1 (x=0) and Face2 (x=1) of a box are opposite
+        proj.to_faces((0.5, 0.5, 0.5), {0, 1})
