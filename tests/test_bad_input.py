@@ -484,8 +484,9 @@ def test_pinned_python_fuzz_findings(name):
 
 
 def test_internal_error_of_the_core_is_reported_cleanly(cli, tmp_path):
-    """plate_holes ends in the core's internal error for now (issue 3): exit 1, a message that says
-    it is our fault, nothing written. Once the core meshes it, the mesh must be valid instead."""
+    """plate_holes: the core of this branch's base ended in an internal error (exit 1, a message
+    that says it is our fault, nothing written); main's core meshes it, and then the mesh must be
+    valid. The error path itself is tested with a test double below."""
     out = tmp_path / "plate.vtu"
     r = run_cli(cli, "mesh", corpus_path("plate_holes"), "-o", out, "--quiet")
     if r.returncode == 0:
@@ -495,4 +496,21 @@ def test_internal_error_of_the_core_is_reported_cleanly(cli, tmp_path):
     assert r.returncode == 1, r.stderr
     assert "the mesher failed" in r.stderr and "please report it" in r.stderr
     assert "plate_holes.off" in r.stderr and "Traceback" not in r.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_meshing_error_of_the_core_becomes_exit_1_and_no_file(tmp_path, monkeypatch, capsys):
+    """The core's MeshingError (an internal limit; issue 3's business) through core.py and the CLI
+    (in this process, without the supervisor): exit 1, a message saying it is a bug, no file."""
+    from FemBspTet import _bsptet, cli
+
+    def failing(*args, **kwargs):
+        raise _bsptet.MeshingError("could not move the surface Steiner point (test double)")
+
+    monkeypatch.setattr(_bsptet, "tetrahedralize", failing)
+    out = tmp_path / "o.vtu"
+    code = cli.main(["mesh", paper_path("schoenhardt"), "-o", str(out), "--quiet"], supervise=False)
+    err = capsys.readouterr().err
+    assert code == 1, err
+    assert "the mesher failed" in err and "please report it" in err and "schoenhardt.off" in err
     assert os.listdir(tmp_path) == []
