@@ -91,7 +91,24 @@ def add_properties(obj):
         obj.setEditorMode(name, 1)  # read-only in the property editor
 
 
-class MeshBspTet:
+class StatelessProxy:
+    """Proxy serialisation with no state, for both pairs FreeCAD calls: __getstate__/__setstate__
+    (0.20) and dumps/loads (newer versions). Everything lives in the object's properties."""
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+
+class MeshBspTet(StatelessProxy):
     """Proxy of the mesher object. Holds no state of its own (everything is in properties)."""
 
     Type = PROXY_TYPE
@@ -105,19 +122,6 @@ class MeshBspTet:
 
     def execute(self, obj):
         """Recompute never meshes (as FEM's Gmsh object): meshing is an explicit action."""
-        return None
-
-    # FreeCAD 0.20 calls __getstate__/__setstate__, newer versions dumps/loads: both, no state.
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
         return None
 
 

@@ -273,18 +273,20 @@ def read_surface(path):
 _OFF_KEYWORD = re.compile(r"(ST)?(C)?(N)?(4)?(n)?OFF", re.IGNORECASE)
 
 
+def _parse_int(src, k, token, what):
+    """A non-negative integer from ``token`` on line ``k`` of ``src``, named ``what`` in errors."""
+    try:
+        value = int(token)
+    except ValueError:
+        raise InputError(f"cannot read {token!r} as the {what} (an integer)",
+                         where=src.where(k)) from None
+    if value < 0:
+        raise InputError(f"the {what} is negative ({value})", where=src.where(k))
+    return value
+
+
 def _parse_counts(src, k, tokens, names):
-    values = []
-    for name, token in zip(names, tokens):
-        try:
-            value = int(token)
-        except ValueError:
-            raise InputError(f"cannot read {token!r} as the {name} (an integer)",
-                             where=src.where(k)) from None
-        if value < 0:
-            raise InputError(f"the {name} is negative ({value})", where=src.where(k))
-        values.append(value)
-    return values
+    return [_parse_int(src, k, token, name) for name, token in zip(names, tokens)]
 
 
 def _read_off(path, data):

@@ -7,12 +7,14 @@ Holds no state that is saved (both serialisation pairs return None).
 
 import os
 
+from .mesher_object import StatelessProxy
+
 #: Icon of the mesher object and of its command.
 ICON_PATH = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                          "resources", "icons", "FEM_MeshBspTetFromShape.svg")
 
 
-class VPMeshBspTet:
+class VPMeshBspTet(StatelessProxy):
     def __init__(self, vobj):
         vobj.Proxy = self
         self.ViewObject = vobj
@@ -71,16 +73,3 @@ class VPMeshBspTet:
             return True
         gui_doc.setEdit(vobj.Object.Name)
         return True
-
-    # FreeCAD 0.20 calls __getstate__/__setstate__, newer versions dumps/loads: both, no state.
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None

@@ -72,6 +72,7 @@ from .surface_io import (
     _extension,
     _format_rows,
     _parse_block,
+    _parse_int,
     _read_bytes,
     _unknown_extension,
 )
@@ -1137,17 +1138,6 @@ def _read_tetgen_files(node_path, ele_path):
     mesh = TetMesh(points, tets, extra=extra)
     mesh.source = node_path
     return mesh
-
-
-def _parse_int(src, k, token, what):
-    try:
-        value = int(token)
-    except ValueError:
-        raise InputError(f"cannot read {token!r} as the {what} (an integer)",
-                         where=src.where(k)) from None
-    if value < 0:
-        raise InputError(f"negative {what} {value}", where=src.where(k))
-    return value
 
 
 # --------------------------------------------------------------------------------------------

@@ -42,3 +42,17 @@ def tetgen_meshes():
         surface = read_surface(paper_path(name))
         out[name] = (surface, run_tetgen(surface, "pY").mesh)
     return out
+
+
+@pytest.fixture(scope="module")
+def fc():
+    """(FreeCAD, Part, Fem), FreeCAD bootstrapped headless (freecad_env). Test modules that need
+    FreeCAD skip themselves first when it is missing; test_cad_tessellation has its own (FreeCAD,
+    Part) variant."""
+    from FemBspTet.freecad_env import import_freecad
+
+    freecad = import_freecad()
+    import Fem
+    import Part
+
+    return freecad, Part, Fem

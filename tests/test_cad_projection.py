@@ -18,17 +18,6 @@ if not freecad_available():
                 allow_module_level=True)
 
 
-@pytest.fixture(scope="module")
-def fc():
-    from FemBspTet.freecad_env import import_freecad
-
-    freecad = import_freecad()
-    import Fem
-    import Part
-
-    return freecad, Part, Fem
-
-
 def placed(fc, shape):
     freecad, _, _ = fc
     shape = shape.copy()

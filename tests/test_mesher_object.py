@@ -20,17 +20,6 @@ import FemBspTet  # noqa: E402
 from FemBspTet import mesh_pipeline as mp  # noqa: E402
 
 
-@pytest.fixture(scope="module")
-def fc():
-    from FemBspTet.freecad_env import import_freecad
-
-    freecad = import_freecad()
-    import Fem
-    import Part
-
-    return freecad, Part, Fem
-
-
 @pytest.fixture
 def doc(fc):
     freecad = fc[0]

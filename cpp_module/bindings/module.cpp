@@ -55,6 +55,14 @@ py::dict quality_dict(const QualityStats& q) {
   return d;
 }
 
+SurfaceMesh surface_from(const DoubleArray& points, const IndexArray& triangles, const char* points_name = "points",
+                         const char* triangles_name = "triangles") {
+  SurfaceMesh s;
+  s.xyz = points_from(points, points_name);
+  s.tri = indices_from(triangles, triangles_name, 3);
+  return s;
+}
+
 TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
   TetMesh m;
   m.xyz = points_from(points, "points");
@@ -93,9 +101,7 @@ PYBIND11_MODULE(_bsptet, m) {
       "tetrahedralize",
       [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
          py::object cancel) {
-        SurfaceMesh s;
-        s.xyz = points_from(points, "points");
-        s.tri = indices_from(triangles, "triangles", 3);
+        const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
         bool interrupted = false;
@@ -164,9 +170,7 @@ PYBIND11_MODULE(_bsptet, m) {
       "check_surface",
       [](const DoubleArray& points, const IndexArray& triangles, bool reorient, bool self_intersections,
          std::int64_t max_reported_pairs) {
-        SurfaceMesh s;
-        s.xyz = points_from(points, "points");
-        s.tri = indices_from(triangles, "triangles", 3);
+        const SurfaceMesh s = surface_from(points, triangles);
         SurfaceCheckOptions o;
         o.reorient = reorient;
         o.self_intersections = self_intersections;
@@ -228,9 +232,7 @@ PYBIND11_MODULE(_bsptet, m) {
       "check_mesh",
       [](const DoubleArray& surface_points, const IndexArray& surface_triangles, const DoubleArray& points,
          const IndexArray& tets, int max_messages, bool compute_quality) {
-        SurfaceMesh s;
-        s.xyz = points_from(surface_points, "surface_points");
-        s.tri = indices_from(surface_triangles, "surface_triangles", 3);
+        const SurfaceMesh s = surface_from(surface_points, surface_triangles, "surface_points", "surface_triangles");
         const TetMesh mesh = tetmesh_from(points, tets);
         MeshCheckOptions o;
         o.max_messages = max_messages;

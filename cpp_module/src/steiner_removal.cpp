@@ -167,16 +167,9 @@ class TetComplex {
       if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
       repl.push_back(t);
     }
-    // A new tet must not duplicate one u already has (a topological safeguard; geometry rules it out).
-    for (const auto& t : repl) {
-      std::array<Index, 4> key = t;
-      std::sort(key.begin(), key.end());
-      for (Index id : vt_[u]) {
-        std::array<Index, 4> k2 = tets_[id];
-        std::sort(k2.begin(), k2.end());
-        if (k2 == key && std::find(star.begin(), star.end(), id) == star.end()) return false;
-      }
-    }
+    std::vector<Index> sorted_star = star;
+    std::sort(sorted_star.begin(), sorted_star.end());
+    if (!tets_are_new(repl, sorted_star)) return false;
     for (Index id : star) kill_tet(id);
     for (const auto& t : repl) add_tet(t);
     const std::vector<Index> fstar = vb_[v];
@@ -924,7 +917,6 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       for (const auto& [ring, x] : by_ring)
         if ((flipped = mesh.remove_edge(v, x))) break;
       if (!flipped) break;
-      ++st.flips;
       for (Index u : mesh.neighbours(v))
         if (mesh.try_substitute(v, u) || mesh.cone_from_vertex(v, u, 6, 400)) {
           gone = true;

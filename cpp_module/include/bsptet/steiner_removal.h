@@ -67,7 +67,7 @@ struct SteinerRemovalOptions {
 
 struct SteinerRemovalStats {
   std::int64_t steiner_before = 0, boundary_steiner_before = 0;
-  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0, flips = 0;
+  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0;
   std::int64_t boundary_steiner_after = 0;
 };
 
