@@ -47,10 +47,27 @@ class Refiner {
   void run() {
     compute_targets();
     size_phase();
-    optimize_phase();
+    optimize_phase(o_.optimize_rounds);
+    // Collapses and smoothing may have left some edges long again: one more short round.
+    if (o_.max_passes > 0) {
+      size_phase();
+      optimize_phase(std::min(2, o_.optimize_rounds));
+    }
     compute_targets();
     for (const auto& e : m_.edges())
       if (is_long(e[0], e[1])) ++st_.long_edges_left;
+    if (std::getenv("BSPTET_REFINE_TRACE")) {
+      const auto worst = tets_below(5.0);
+      for (std::size_t i = 0; i < worst.size() && i < 5; ++i) {
+        const auto& q = m_.tet(worst[i]);
+        std::fprintf(stderr, "worst tet %d q %.3f supports", worst[i], m_.tet_quality(worst[i]));
+        for (Index v : q) std::fprintf(stderr, " %d:%d", v, static_cast<int>(m_.support(v).kind));
+        std::fprintf(stderr, " edges");
+        for (int a = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b) std::fprintf(stderr, " %d", static_cast<int>(m_.edge_kind(q[a], q[b])));
+        std::fprintf(stderr, "\n");
+      }
+    }
   }
 
  private:
@@ -255,10 +272,13 @@ class Refiner {
 
   std::int64_t flip_pass(double below) {
     std::int64_t flips = 0;
+    std::vector<char> tried(static_cast<std::size_t>(m_.num_tet_slots()), 0);
     for (int round = 0; round < 4; ++round) {
       std::int64_t now = 0;
       for (Index t : tets_below(below)) {
-        if (!m_.tet_alive(t)) continue;
+        if (!m_.tet_alive(t) || (static_cast<std::size_t>(t) < tried.size() && tried[static_cast<std::size_t>(t)]))
+          continue;
+        if (static_cast<std::size_t>(t) < tried.size()) tried[static_cast<std::size_t>(t)] = 1;
         bool done = false;
         const auto q = m_.tet(t);
         for (int i = 0; i < 4 && !done; ++i)
@@ -286,7 +306,7 @@ class Refiner {
     for (const auto& e : m_.edges()) {
       const double l = length(e[0], e[1]);
       const double t = edge_target(e[0], e[1]);
-      if (std::isfinite(t) ? l < 0.5 * t : false) todo.emplace_back(l / t, e[0], e[1]);
+      if (std::isfinite(t) ? l < o_.collapse_ratio * t : false) todo.emplace_back(l / t, e[0], e[1]);
     }
     std::sort(todo.begin(), todo.end());
     std::int64_t n = 0;
@@ -349,11 +369,12 @@ class Refiner {
     c = {c.x / k, c.y / k, c.z / k};
     mean_edge /= k;
     const Vec3 p = m_.point(v);
-    for (double f : {1.0, 0.5, 0.25}) {
+    for (double f : {1.0, 0.5, 0.25, 0.1}) {
       const Vec3 q{p.x + f * (c.x - p.x), p.y + f * (c.y - p.y), p.z + f * (c.z - p.z)};
       if (m_.relocate_point(v, q)) return true;
     }
-    // Normal of the face opposite v in its worst tet, pointing to v's side.
+    // Normal of the face opposite v in its worst tet, pointing to the side of the neighbours'
+    // centroid (v itself may lie almost on that face's plane).
     const auto& q = m_.tet(worst_tet);
     Vec3 f[3];
     int j = 0;
@@ -364,12 +385,12 @@ class Refiner {
     double nx = uy * wz - uz * wy, ny = uz * wx - ux * wz, nz = ux * wy - uy * wx;
     const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
     if (!(len > 0)) return false;
-    const double side = nx * (p.x - f[0].x) + ny * (p.y - f[0].y) + nz * (p.z - f[0].z);
+    const double side = nx * (c.x - f[0].x) + ny * (c.y - f[0].y) + nz * (c.z - f[0].z);
     const double sgn = side >= 0 ? 1.0 : -1.0;
     nx *= sgn / len;
     ny *= sgn / len;
     nz *= sgn / len;
-    for (double a : {0.3, 0.15, 0.07, 0.03}) {
+    for (double a : {0.3, 0.15, 0.07, 0.03, 0.01}) {
       const Vec3 r{p.x + a * mean_edge * nx, p.y + a * mean_edge * ny, p.z + a * mean_edge * nz};
       if (m_.relocate_point(v, r)) return true;
     }
@@ -439,10 +460,10 @@ class Refiner {
     return n;
   }
 
-  void optimize_phase() {
+  void optimize_phase(int rounds) {
     const double goal = o_.min_dihedral_deg > 0 ? o_.min_dihedral_deg : 70.0;
-    for (int round = 0; round < o_.optimize_rounds; ++round) {
-      poll("optimizing", 0.5 + 0.5 * round / std::max(1, o_.optimize_rounds));
+    for (int round = 0; round < rounds; ++round) {
+      poll("optimizing", 0.5 + 0.5 * round / std::max(1, rounds));
       const double before = worst_quality();
       std::int64_t changes = 0;
       changes += collapse_pass();
@@ -450,11 +471,11 @@ class Refiner {
       changes += smooth_pass(std::max(goal, 30.0));
       changes += radius_edge_pass();
       changes += flip_pass(std::max(goal, 30.0));
-      if (round + 1 < o_.optimize_rounds) changes += sliver_pass(std::min(goal, 15.0));
+      if (round + 1 < rounds) changes += sliver_pass(std::min(goal, 15.0));
       ++st_.optimize_rounds;
       const double after = worst_quality();
-      if (changes == 0 || (o_.min_dihedral_deg > 0 && after >= o_.min_dihedral_deg && before >= o_.min_dihedral_deg))
-        break;
+      (void)before;
+      if (changes == 0 || (o_.min_dihedral_deg > 0 && after >= o_.min_dihedral_deg)) break;
     }
   }
 

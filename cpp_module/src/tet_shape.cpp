@@ -37,14 +37,11 @@ double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const V
     if (!(len[i] > 0)) return 0.0;
   }
   // The dihedral angle at the edge shared by faces i and j is pi minus the angle of their normals.
-  double best = 180.0;
+  // The smallest angle has the largest cosine: one acos per tet.
+  double largest = -1.0;
   for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) {
-      double cosine = -dot(n[i], n[j]) / (len[i] * len[j]);
-      cosine = std::max(-1.0, std::min(1.0, cosine));
-      best = std::min(best, std::acos(cosine) * 180.0 / kPi);
-    }
-  return best;
+    for (int j = i + 1; j < 4; ++j) largest = std::max(largest, -dot(n[i], n[j]) / (len[i] * len[j]));
+  return std::acos(std::max(-1.0, std::min(1.0, largest))) * 180.0 / kPi;
 }
 
 double tet_radius_edge_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--radius-edge")) o.radius_edge_bound = value();
     else if (!std::strcmp(argv[i], "--min-dihedral")) o.min_dihedral_deg = value();
     else if (!std::strcmp(argv[i], "--split-ratio")) o.split_ratio = value();
+    else if (!std::strcmp(argv[i], "--collapse-ratio")) o.collapse_ratio = value();
     else if (!std::strcmp(argv[i], "--rounded")) o.surface_points = SurfacePoints::kRounded;
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
     else {

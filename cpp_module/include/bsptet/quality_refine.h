@@ -50,6 +50,9 @@ struct RefineOptions {
   /// An edge is split when longer than split_ratio * target (1.0 would make `size` a strict
   /// maximum; about sqrt 2 matches the element counts of Gmsh and TetGen at the same size).
   double split_ratio = 1.4;
+  /// Edges shorter than collapse_ratio * target are collapsed where a Steiner point can go (never
+  /// making the worst tet around worse, nor an edge longer than split_ratio * target).
+  double collapse_ratio = 0.5;
   /// Tets whose circumradius / shortest edge exceeds this are refined (0: no bound). TetGen's -q
   /// default is 2.0; 1.414 is stricter.
   double radius_edge_bound = 0;
