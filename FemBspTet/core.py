@@ -103,7 +103,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
         raise InputError(f"order must be 1 or 2, got {order}")
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
-    refining = any(options.get(k) is not None for k in REFINE_OPTIONS if k != "order")
+    refining = any(options.get(k) is not None for k in REFINE_OPTIONS
+                   if k not in ("order", "projection"))
     native = _native()
     meshes, all_stats = [], []
     for k, surface in enumerate(surfaces):
@@ -133,9 +134,16 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
                 f"{surface.source or 'surface'}: the mesh failed its own exact check ("
                 + "; ".join(report_check["messages"]) + "); this is a bug, please report it")
         if refining or order == 2:
-            mesh, refine_stats = refine(surface, mesh, options if refining else {"order": 2},
-                                        progress=report, cancel=cancel)
+            refine_options = {k: v for k, v in options.items() if k in REFINE_OPTIONS}
+            if not refining:
+                refine_options = {"order": 2, "projection": options.get("projection")}
+            mesh, refine_stats = refine(surface, mesh, refine_options, progress=report,
+                                        cancel=cancel)
             st["refine"] = refine_stats
+            st["steiner_points"] = refine_stats["steiner_points"]
+            st["boundary_steiner_points"] = refine_stats["boundary_steiner_points"]
+            st["interior_steiner_points"] = (refine_stats["steiner_points"]
+                                             - refine_stats["boundary_steiner_points"])
             st["points"] = refine_stats["points"]
             st["tets"] = refine_stats["tets"]
             st["quality"] = refine_stats["quality"]
@@ -313,6 +321,9 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             f"{surface.source or 'surface'}: the refined mesh failed its own exact check ("
             + "; ".join(report["messages"]) + "); this is a bug, please report it")
     st["checked_against"] = "input surface" if exact else "own boundary"
+    on_boundary = len(np.unique(boundary_surface(out).triangles))
+    st["steiner_points"] = int(st["points"] - len(surface.points))
+    st["boundary_steiner_points"] = int(on_boundary - len(surface.points))
     st["quality"] = report["quality"]
     return out, st
 
