@@ -1,8 +1,6 @@
 #include "bsptet/quality_refine.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -56,18 +54,6 @@ class Refiner {
     compute_targets();
     for (const auto& e : m_.edges())
       if (is_long(e[0], e[1])) ++st_.long_edges_left;
-    if (std::getenv("BSPTET_REFINE_TRACE")) {
-      const auto worst = tets_below(5.0);
-      for (std::size_t i = 0; i < worst.size() && i < 5; ++i) {
-        const auto& q = m_.tet(worst[i]);
-        std::fprintf(stderr, "worst tet %d q %.3f supports", worst[i], m_.tet_quality(worst[i]));
-        for (Index v : q) std::fprintf(stderr, " %d:%d", v, static_cast<int>(m_.support(v).kind));
-        std::fprintf(stderr, " edges");
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) std::fprintf(stderr, " %d", static_cast<int>(m_.edge_kind(q[a], q[b])));
-        std::fprintf(stderr, "\n");
-      }
-    }
   }
 
  private:
@@ -245,8 +231,6 @@ class Refiner {
         done += split(u, v, 0) ? 1 : 0;
       }
       ++st_.size_passes;
-      if (std::getenv("BSPTET_REFINE_TRACE"))
-        std::fprintf(stderr, "size pass %d: %zu long, %lld split, %d tets\n", pass, todo.size(), (long long)done, m_.num_alive_tets());
       flip_pass(30.0);
       if (done == 0) break;
     }
