@@ -4,10 +4,12 @@ belongs to, so that ``FemMesh.getNodesByFace`` finds it and FreeCAD constraints 
 Contract of the hook (shared with the quality stage, ``core.tetrahedralize(...,
 options={"projection": hook})``)::
 
-    hook(point, face_tag) -> point
-      point:    3 floats, global coordinates in mm (a point on or near the face's triangles)
-      face_tag: 0-based index into ``shape.Faces`` (the ``Surface.face_tags`` of
-                :mod:`FemBspTet.cad_tessellation`)
+    hook(point, face_tag, other_tag=-1) -> point
+      point:     3 floats, global coordinates in mm (a point on or near the face's triangles)
+      face_tag:  0-based index into ``shape.Faces`` (the ``Surface.face_tags`` of
+                 :mod:`FemBspTet.cad_tessellation`)
+      other_tag: -1, or the second face when the point is on a surface edge between two CAD
+                 faces (then the point goes onto their common CAD edge)
       returns:  a tuple of 3 floats, the nearest point of the trimmed CAD face
 
 :class:`CadProjection` is that hook for one ``Part.Shape``. It also projects onto the CAD edge
@@ -72,7 +74,13 @@ class CadProjection:
         """``BRep_Tool::Tolerance`` of the face: the limit ``getNodesByFace`` uses."""
         return float(self.face(face_tag).Tolerance)
 
-    def __call__(self, point, face_tag):
+    def __call__(self, point, face_tag, other_tag=-1):
+        """The core's hook (``core.REFINE_OPTIONS["projection"]``): onto face ``face_tag``, or
+        onto the CAD edge between ``face_tag`` and ``other_tag`` when ``other_tag`` is a
+        different face (a point on a surface edge between two CAD faces)."""
+        other_tag = int(other_tag)
+        if other_tag >= 0 and other_tag != int(face_tag):
+            return self.to_faces(point, (face_tag, other_tag))
         return self.to_face(point, face_tag)
 
     def to_face(self, point, face_tag):

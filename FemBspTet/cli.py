@@ -1,8 +1,9 @@
 """The ``fembsptet`` command line.
 
-    fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--order 1|2] [--stats-json FILE]
-                   [--quiet] [--reorient] [--write-intersections FILE] [--max-memory SIZE]
-                   [--timeout SECONDS]
+    fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]
+                   [--min-dihedral D] [--surface-points exact|rounded] [--order 1|2]
+                   [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
+                   [--max-memory SIZE] [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
 
 Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
@@ -44,6 +45,8 @@ STATS_KEYS = (
     "min_dihedral_deg",
     "max_dihedral_deg",
     "max_radius_edge_ratio",
+    "p1_dihedral_deg",
+    "median_dihedral_deg",
     "seconds_total",
     "seconds_by_stage",
     "valid",
@@ -119,8 +122,10 @@ def _check_mesh_args(args):
     """Option checks done before any work (and before the supervised child starts)."""
     for out in args.output:
         check_output_path(out)
-    if args.size is not None and not (args.size > 0 and math.isfinite(args.size)):
-        raise InputError(f"--size must be a positive length, got {args.size}")
+    for name in ("size", "min_size", "radius_edge", "min_dihedral"):
+        value = getattr(args, name, None)
+        if value is not None and not (value > 0 and math.isfinite(value)):
+            raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {value}")
     if args.timeout is not None and not (args.timeout > 0 and math.isfinite(args.timeout)):
         raise InputError(f"--timeout must be a positive number of seconds, got {args.timeout}")
     if args.write_intersections is not None:
@@ -173,7 +178,11 @@ def _cmd_mesh(args):
     try:
         mesh, stats = core.tetrahedralize(
             surfaces,
-            options={"size": args.size if _ext(args.input) in SURFACE_EXTENSIONS else None,
+            options={"size": args.size,
+                     "min_size": args.min_size,
+                     "radius_edge": args.radius_edge,
+                     "min_dihedral": args.min_dihedral,
+                     "surface_points": args.surface_points,
                      "order": args.order,
                      "allow_boundary_steiner": args.allow_boundary_steiner,
                      "reorient": args.reorient,
@@ -305,8 +314,21 @@ def build_parser():
     m.add_argument("input", help="surface (.off .stl .obj .ply) or CAD (.step .stp .brep .iges)")
     m.add_argument("-o", "--output", action="append", required=True,
                    help="output mesh; repeat for several (.vtu .msh .inp .node .mesh .unv .med .z88)")
-    m.add_argument("--size", type=float, default=None, help="maximum element size (edge length)")
-    m.add_argument("--order", type=int, choices=(1, 2), default=1, help="element order")
+    m.add_argument("--size", type=float, default=None,
+                   help="element size h (target edge length; edges longer than about 1.4 h are "
+                        "split); also the CAD tessellation size")
+    m.add_argument("--min-size", type=float, default=None,
+                   help="edges shorter than twice this are never split (default: size / 8)")
+    m.add_argument("--radius-edge", type=float, default=None,
+                   help="refine tets whose circumradius / shortest edge exceeds this (e.g. 2)")
+    m.add_argument("--min-dihedral", type=float, default=None,
+                   help="optimize until the smallest dihedral angle reaches this (degrees)")
+    m.add_argument("--surface-points", choices=("exact", "rounded"), default=None,
+                   help="exact (default): new surface points exactly on the input facets, none "
+                        "where no double lies on them; rounded: rounded midpoints everywhere "
+                        "(boundary within rounding of the input, checked against itself)")
+    m.add_argument("--order", type=int, choices=(1, 2), default=1,
+                   help="element order (2: 10-node tets)")
     m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
     m.add_argument("--quiet", action="store_true", help="no progress bar and no statistics on stdout")
     m.add_argument("--allow-boundary-steiner", action="store_true",

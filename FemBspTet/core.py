@@ -113,11 +113,13 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is positive.
 
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``order`` (1 or 2),
-    ``size`` (maximum edge length: used for the tessellation of CAD input; volume sizing is not
-    built yet and is reported in ``stats["notes"]``), ``reorient`` (bool, default False: flip
-    inconsistently oriented or inward-facing shells instead of refusing them, see
-    :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before meshing, a run whose
-    estimated peak memory exceeds it, :class:`MemoryBudgetError`; see :mod:`memory_budget`).
+    ``reorient`` (bool, default False: flip inconsistently oriented or inward-facing shells instead
+    of refusing them, see :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before
+    meshing, a run whose estimated peak memory exceeds it, :class:`MemoryBudgetError`; see
+    :mod:`memory_budget`), and the quality stage's options (see ``REFINE_OPTIONS`` and ``refine``):
+    ``size``, ``min_size``, ``size_by_tag``, ``radius_edge``, ``min_dihedral``, ``surface_points``,
+    ``projection``. When any of them is given the core's mesh goes through ``refine``; ``order`` 2
+    alone only adds the mid-edge nodes (through ``projection`` if given).
     ``progress(stage, fraction)`` is called now and then; ``cancel()`` returning True stops the run
     (:class:`Cancelled`); Ctrl-C raises ``KeyboardInterrupt``.
 
@@ -128,7 +130,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     from .errors import InputError
 
     options = dict(options or {})
-    unknown = set(options) - {"allow_boundary_steiner", "order", "size", "reorient", "max_memory"}
+    unknown = set(options) - set(OPTION_NAMES)
     if unknown:
         raise InputError(f"unknown mesher option(s): {', '.join(sorted(unknown))}")
     order = int(options.get("order") or 1)
@@ -136,6 +138,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
         raise InputError(f"order must be 1 or 2, got {order}")
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
+    refining = any(options.get(k) is not None for k in REFINE_OPTIONS
+                   if k not in ("order", "projection"))
     native = _native()
     checked, flipped = [], 0
     for surface in surfaces:
@@ -174,12 +178,25 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             raise InternalError(
                 f"{surface.source or 'surface'}: the mesh failed its own exact check ("
                 + "; ".join(report_check["messages"]) + "); this is a bug, please report it")
-        st["quality"] = report_check["quality"]
+        if refining or order == 2:
+            refine_options = {k: v for k, v in options.items() if k in REFINE_OPTIONS}
+            if not refining:
+                refine_options = {"order": 2, "projection": options.get("projection")}
+            mesh, refine_stats = refine(surface, mesh, refine_options, progress=report,
+                                        cancel=cancel)
+            st["refine"] = refine_stats
+            st["steiner_points"] = refine_stats["steiner_points"]
+            st["boundary_steiner_points"] = refine_stats["boundary_steiner_points"]
+            st["interior_steiner_points"] = (refine_stats["steiner_points"]
+                                             - refine_stats["boundary_steiner_points"])
+            st["points"] = refine_stats["points"]
+            st["tets"] = refine_stats["tets"]
+            st["quality"] = refine_stats["quality"]
+        else:
+            st["quality"] = report_check["quality"]
         meshes.append(mesh)
         all_stats.append(st)
     mesh = _concatenate(meshes)
-    if order == 2:
-        mesh = to_second_order(mesh)
     stats = _merge_stats(all_stats)
     stats["order"] = order
     stats["nodes"] = int(len(mesh.points))
@@ -188,8 +205,17 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     notes = []
     if flipped:
         notes.append(f"re-oriented {flipped} triangle(s) (--reorient)")
-    if options.get("size") is not None:
-        notes.append("volume size control is not built yet: tets use the surface's vertices only")
+    for st in all_stats:
+        r = st.get("refine", {})
+        if r.get("splits_no_exact_point"):
+            notes.append(
+                f"{r['splits_no_exact_point']} surface edge splits were skipped: no double lies exactly "
+                "on those facets or edges near the midpoint, so elements there stay larger than the "
+                "size (surface_points='rounded' / --surface-points rounded refines them, with the "
+                "boundary then within rounding of the input)")
+        if r.get("midnodes_straightened"):
+            notes.append(f"{r['midnodes_straightened']} curved mid-nodes were put back on their chord "
+                         "(the curved tet would not have been valid)")
     stats["notes"] = notes
     return mesh, stats
 
@@ -209,6 +235,12 @@ def _merge_stats(all_stats):
         for k, v in st.items():
             if k == "quality":
                 continue
+            if k == "refine":
+                agg = out.setdefault(k, {})
+                for key, value in v.items():
+                    if isinstance(value, (int, float)) and not isinstance(value, bool):
+                        agg[key] = agg.get(key, 0) + value
+                continue
             if k == "seconds_by_stage":
                 agg = out.setdefault(k, {})
                 for stage, sec in v.items():
@@ -220,6 +252,7 @@ def _merge_stats(all_stats):
     out["max_dihedral_deg"] = max(q["max_dihedral_deg"] for q in qs)
     out["max_radius_edge_ratio"] = max(q["max_radius_edge_ratio"] for q in qs)
     out["median_dihedral_deg"] = qs[0]["median_dihedral_deg"] if len(qs) == 1 else None
+    out["median_radius_edge_ratio"] = qs[0]["median_radius_edge_ratio"] if len(qs) == 1 else None
     out["p1_dihedral_deg"] = qs[0]["p1_dihedral_deg"] if len(qs) == 1 else None
     out["dihedral_histogram"] = [sum(h) for h in zip(*(q["dihedral_histogram"] for q in qs))]
     out["solids"] = len(all_stats)
@@ -241,3 +274,119 @@ def signed_volume(surface: Surface) -> float:
     o = p[t[0, 0]]
     a, b, c = p[t[:, 0]] - o, p[t[:, 1]] - o, p[t[:, 2]] - o
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+# ---- Quality stage (issue 4) -----------------------------------------------------------------
+
+#: Options of the quality stage (cpp_module/include/bsptet/quality_refine.h), with their meaning.
+REFINE_OPTIONS = {
+    "size": "target edge length h (model units; edges longer than about 1.4 h are split)",
+    "min_size": "edges shorter than 2 min_size are never split (default: smallest size / 8)",
+    "size_by_tag": "{face tag: size} near the input triangles of that tag (a CAD face)",
+    "radius_edge": "refine tets whose circumradius / shortest edge exceeds this (0 or None: off)",
+    "min_dihedral": "the optimization stops once the smallest dihedral angle reaches this (deg)",
+    "surface_points": "'exact' (default): new surface points exactly on the input facets, else "
+                      "none; 'rounded': rounded midpoints (boundary within rounding of the input)",
+    "projection": "callable (point (3,), tag, other_tag) -> point moving new surface points onto "
+                  "the true surface (other_tag is -1 except on an edge between two face tags)",
+    "order": "1 or 2 (10-node tets; boundary mid-nodes through projection)",
+}
+
+#: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
+#: onto these, ``mesh_pipeline.CORE_OPTION_OF``).
+OPTION_NAMES = ("allow_boundary_steiner", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
+
+
+def _positive_number(name, value, allow_zero=False):
+    from .errors import InputError
+
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"option {name} must be a number, got {value!r}") from None
+    if not (v > 0 or (allow_zero and v == 0)) or v != v or v == float("inf"):
+        raise InputError(f"option {name} must be a positive finite number"
+                         f"{' or 0' if allow_zero else ''}, got {value!r}")
+    return v
+
+
+def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=None):
+    """Refines and optimizes ``mesh``, a valid linear tet mesh of ``surface`` (the core's output).
+
+    ``options``: see ``REFINE_OPTIONS``. Returns ``(TetMesh, stats)``: the stats of the stage
+    (splits, collapses, flips, ... see quality_refine.h) and ``quality`` (dihedral angles: min,
+    1st percentile, median, histogram; radius-edge ratios). The result is checked exactly before
+    it is returned: against ``surface`` in exact mode (the boundary tiles the input triangles);
+    against its own boundary with ``surface_points='rounded'`` or a ``projection`` (positive tets,
+    conforming faces, closed boundary; the boundary then is the refined, projected surface).
+    Raises ``InputError`` for bad options, ``InternalError`` otherwise.
+    """
+    from .errors import InputError
+
+    options = dict(options or {})
+    unknown = set(options) - set(REFINE_OPTIONS)
+    if unknown:
+        raise InputError(f"unknown refinement option(s): {', '.join(sorted(unknown))}")
+    size = options.get("size")
+    size = float("inf") if size is None else _positive_number("size", size)
+    min_size = options.get("min_size")
+    min_size = 0.0 if min_size is None else _positive_number("min_size", min_size, allow_zero=True)
+    by_tag = {}
+    for tag, value in (options.get("size_by_tag") or {}).items():
+        by_tag[int(tag)] = _positive_number(f"size_by_tag[{tag}]", value)
+    radius_edge = options.get("radius_edge") or 0.0
+    radius_edge = _positive_number("radius_edge", radius_edge, allow_zero=True)
+    min_dihedral = options.get("min_dihedral") or 0.0
+    min_dihedral = _positive_number("min_dihedral", min_dihedral, allow_zero=True)
+    order = int(options.get("order") or 1)
+    if order not in (1, 2):
+        raise InputError(f"order must be 1 or 2, got {order}")
+    mode = options.get("surface_points") or "exact"
+    if mode not in ("exact", "rounded"):
+        raise InputError(f"surface_points must be 'exact' or 'rounded', got {mode!r}")
+    projection = options.get("projection")
+    if projection is not None and not callable(projection):
+        raise InputError("projection must be a callable (point, tag, other_tag) -> point")
+    only_order = set(k for k, v in options.items() if v is not None) <= {"order", "projection"}
+    native = _native()
+    try:
+        points, tets, st = native.refine(
+            surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
+            size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
+            min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
+            projection=projection, max_passes=0 if only_order else 40,
+            optimize_rounds=0 if only_order else 8, progress=progress, cancel=cancel)
+    except native.InputError as exc:
+        raise InputError(str(exc)) from None
+    except native.MeshingError as exc:
+        if getattr(exc, "code", "") == "cancelled":
+            raise InternalError("cancelled: no mesh was made") from None
+        raise InternalError(
+            f"{surface.source or 'surface'}: the refinement failed ({exc}); this is a bug, "
+            "please report it with the input") from None
+    out = TetMesh(points, tets, mesh.source)
+    exact = mode == "exact" and projection is None
+    reference = surface if exact else boundary_surface(out)
+    report = check_mesh(reference, out, max_messages=5)
+    if not report["valid"]:
+        raise InternalError(
+            f"{surface.source or 'surface'}: the refined mesh failed its own exact check ("
+            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    st["checked_against"] = "input surface" if exact else "own boundary"
+    on_boundary = len(np.unique(boundary_surface(out).triangles))
+    st["steiner_points"] = int(st["points"] - len(surface.points))
+    st["boundary_steiner_points"] = int(on_boundary - len(surface.points))
+    st["quality"] = report["quality"]
+    return out, st
+
+
+def boundary_surface(mesh: TetMesh) -> Surface:
+    """The faces of exactly one tet of ``mesh`` (first four nodes), outward, as a Surface on the
+    mesh's points. Used as the reference of the exact check when the boundary was moved on
+    purpose (rounded surface points or a projection hook)."""
+    tets = mesh.tets[:, :4]
+    outward = ((1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1))  # types.h, faces opposite 0..3
+    faces = np.concatenate([tets[:, list(f)] for f in outward])
+    key = np.sort(faces, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    return Surface(mesh.points, faces[first[counts == 1]], source=mesh.source)

@@ -41,20 +41,16 @@ import numpy as np
 from .errors import BspTetError, InputError, InternalError, MeshingCancelled
 from .mesh_types import TetMesh
 
-#: Name of each MeshParameters field in ``core.tetrahedralize``'s options. The one place to
-#: adapt when the quality stage (issue 4) settles its option names.
+#: Name of each MeshParameters field in ``core.tetrahedralize``'s options (``core.OPTION_NAMES``).
 CORE_OPTION_OF = {
     "max_size": "size",
     "min_size": "min_size",
-    "quality_bound": "radius_edge_bound",
+    "quality_bound": "radius_edge",
     "order": "order",
     "allow_boundary_steiner": "allow_boundary_steiner",
 }
-#: Option under which the core takes the projection hook ``(point, face_tag) -> point``.
+#: Option under which the core takes the projection hook (``cad_projection.CadProjection``).
 CORE_PROJECTION_OPTION = "projection"
-#: What the core accepts when it does not list its options in ``core.OPTION_NAMES`` (the core
-#: before the quality stage: no size control, no quality bound, no projection hook).
-CORE_OPTIONS_WITHOUT_QUALITY_STAGE = ("allow_boundary_steiner", "order", "size")
 
 #: FreeCAD property name of each MeshParameters field (for messages that name what to change).
 PROPERTY_OF = {
@@ -232,37 +228,16 @@ def _json_default(value):
 # options for the core
 # ------------------------------------------------------------------------------------------
 
-def core_option_names():
-    """Option names ``core.tetrahedralize`` accepts in this build (``core.OPTION_NAMES`` once
-    the core lists them; before that, :data:`CORE_OPTIONS_WITHOUT_QUALITY_STAGE`)."""
-    from . import core
-
-    return tuple(getattr(core, "OPTION_NAMES", CORE_OPTIONS_WITHOUT_QUALITY_STAGE))
-
-
 def core_options(params, projection=None):
-    """The ``options`` dict for ``core.tetrahedralize`` from ``params``.
-
-    Zero (automatic/off) values are left out. A non-zero CharacteristicLengthMin or
-    QualityBound that this build's core cannot honour raises InputError saying so (never
-    silently ignored). The projection hook is included only if the core takes one.
-    """
-    names = core_option_names()
+    """The ``options`` dict for ``core.tetrahedralize`` from ``params`` (zero, i.e. automatic
+    or off, values are left out; the names are in ``core.OPTION_NAMES``)."""
     opts = {CORE_OPTION_OF["order"]: int(params.order),
             CORE_OPTION_OF["allow_boundary_steiner"]: bool(params.allow_boundary_steiner)}
-    if params.max_size > 0:
-        opts[CORE_OPTION_OF["max_size"]] = float(params.max_size)
-    for field in ("min_size", "quality_bound"):
+    for field in ("max_size", "min_size", "quality_bound"):
         value = getattr(params, field)
         if value > 0:
-            key = CORE_OPTION_OF[field]
-            if key not in names:
-                raise InputError(
-                    "%s = %g needs the size control and quality refinement of the core, which "
-                    "this build does not have yet: set %s to 0"
-                    % (PROPERTY_OF[field], value, PROPERTY_OF[field]))
-            opts[key] = float(value)
-    if projection is not None and CORE_PROJECTION_OPTION in names:
+            opts[CORE_OPTION_OF[field]] = float(value)
+    if projection is not None:
         opts[CORE_PROJECTION_OPTION] = projection
     return opts
 

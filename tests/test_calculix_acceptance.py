@@ -1,12 +1,9 @@
 """CalculiX acceptance of the FreeCAD mesher (issue 5), headless: the same analysis solved with our
 mesh and with FreeCAD's Gmsh mesh at the same CharacteristicLengthMax.
 
-What the core can do today is tested as is. The issue's acceptance numbers that cannot be met yet
-are strict xfails with the reason (they turn into failures the day they pass, so the marker gets
-removed): the core has no volume size control yet (the cantilever box at size 500 becomes 12 tets
-where Gmsh makes 400), and its flat elements next to curved faces stop tet10 mid-nodes from being
-put on the hole's cylinder without inverting elements.
-Takes about 5 s (Gmsh and ccx on small meshes).
+The acceptance figures of the FreeCAD issue: the cantilever's maximum displacement within 1% of
+Gmsh tet10's at the same CharacteristicLengthMax, the plate with a hole's within 2%.
+Takes about 30 s (Gmsh and ccx on small meshes).
 """
 
 import shutil
@@ -78,10 +75,6 @@ def test_cantilever_solves_with_our_tet10_mesh(cantilever_ours):
     assert f["min_uz_mm"] < 0 and abs(f["min_uz_mm"]) > 0.95 * f["max_displacement_mm"]
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "no volume size control in the core yet: at CharacteristicLengthMax=500 the box becomes "
-    "12 tet10 (its 8 corners and 1 Steiner point) against Gmsh's 400, and comes out too stiff "
-    "(65.6 mm against 88.15 mm, -26%); needs the size control of issue 4"))
 def test_acceptance_cantilever_within_1_percent_of_gmsh(cantilever_ours, cantilever_gmsh):
     ours, gmsh = cantilever_ours["max_displacement_mm"], cantilever_gmsh["max_displacement_mm"]
     assert abs(ours / gmsh - 1) <= 0.01, (ours, gmsh)
@@ -113,11 +106,6 @@ def test_plate_hole_face_nodes_found_and_pressure_solves(freecad, tmp_path_facto
         freecad.closeDocument(doc.Name)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "tet10 on the plate with a hole cannot be made yet: the core's mesh has flat elements "
-    "(minimum dihedral angle ~0 degrees) at the hole, thinner than the chord sag, so putting the "
-    "mid-nodes on the cylinder would invert them and the pipeline refuses; with tet4 the result "
-    "is 0.0067 mm against Gmsh tet10's 0.0196 mm. Needs the quality refinement of issue 4"))
 def test_acceptance_plate_with_hole_within_2_percent_of_gmsh(freecad, tmp_path_factory,
                                                             plate_gmsh):
     ours = solved(freecad, tmp_path_factory, "plate_with_hole", "bsptet", 2)

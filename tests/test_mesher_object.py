@@ -186,15 +186,39 @@ def test_cancel_keeps_the_previous_mesh(doc, fc):
     assert obj.FemMesh.NodeCount == nodes and obj.MeshStatus.startswith("failed: cancelled")
 
 
-def test_options_the_core_cannot_honour_are_refused(doc, fc):
-    if mp.CORE_OPTION_OF["quality_bound"] in mp.core_option_names():
-        pytest.skip("this core has quality refinement")
+def test_property_names_reach_the_core_under_its_option_names():
+    from FemBspTet import core
+
+    assert set(mp.CORE_OPTION_OF.values()) | {mp.CORE_PROJECTION_OPTION} <= set(core.OPTION_NAMES)
+    hook = object()
+    opts = mp.core_options(mp.MeshParameters(max_size=5, min_size=1, quality_bound=1.5, order=2),
+                           projection=hook)
+    assert opts == {"size": 5.0, "min_size": 1.0, "radius_edge": 1.5, "order": 2,
+                    "allow_boundary_steiner": False, "projection": hook}
+    assert "min_size" not in mp.core_options(mp.MeshParameters(max_size=5))
+
+
+def test_quality_bound_and_sizes_are_honoured(doc, fc):
+    """CharacteristicLengthMax/Min and QualityBound act on the mesh: a smaller size gives more
+    tets, and no edge of the refined mesh is much longer than h."""
     part = add_part(doc, fc, block_with_hole(fc))
-    obj = FemBspTet.make_mesher(doc, part, QualityBound=1.414, CompareWithTetGen=False)
-    with pytest.raises(InputError, match="QualityBound = 1.414 needs the size control"):
-        FemBspTet.run_mesher(obj)
-    with pytest.raises(InputError, match="CharacteristicLengthMin"):
-        mp.core_options(mp.MeshParameters(min_size=1.0))
+    coarse = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False,
+                                   CharacteristicLengthMax=8.0)
+    FemBspTet.run_mesher(coarse)
+    fine = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False,
+                                 CharacteristicLengthMax=4.0, CharacteristicLengthMin=1.0,
+                                 QualityBound=1.414)
+    FemBspTet.run_mesher(fine)
+    assert fine.FemMesh.VolumeCount > 2 * coarse.FemMesh.VolumeCount
+    m = fine.FemMesh
+    xyz = m.Nodes
+    longest = 0.0
+    for e in m.Volumes:
+        nodes = [xyz[n] for n in m.getElementNodes(e)]
+        for i in range(4):
+            for j in range(i + 1, 4):
+                longest = max(longest, (nodes[i] - nodes[j]).Length)
+    assert longest <= 1.45 * 4.0, longest
 
 
 def test_parameters_are_validated_with_property_names():
@@ -208,9 +232,8 @@ def test_parameters_are_validated_with_property_names():
         mp.MeshParameters.from_dict({"size": 3})
     p = mp.MeshParameters(max_size=5, order=1)
     assert mp.MeshParameters.from_dict(p.to_dict()) == p
-    opts = mp.core_options(p, projection=lambda pt, tag: pt)
-    assert opts["size"] == 5 and opts["order"] == 1
-    assert ("projection" in opts) == ("projection" in mp.core_option_names())
+    opts = mp.core_options(p)
+    assert opts["size"] == 5 and opts["order"] == 1 and "projection" not in opts
 
 
 def test_mesh_shape_returns_a_femmesh(fc):

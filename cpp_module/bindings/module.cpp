@@ -11,6 +11,7 @@
 #include "bsptet/mesher.h"
 #include "bsptet/predicates.h"
 #include "bsptet/surface_check.h"
+#include "bsptet/quality_refine.h"
 
 namespace py = pybind11;
 using namespace bsptet;
@@ -206,6 +207,108 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("max_reported_pairs") = 1000,
       "Checks a triangle surface before meshing (see surface_check.h). Returns (triangles (m, 3) with "
       "flipped ones reversed, info dict). Raises InputError naming the first problem.");
+  // ---- Quality stage (issue 4): refine_quality (quality_refine.h). ----
+  m.def(
+      "refine",
+      [](const DoubleArray& surface_points, const IndexArray& surface_triangles, py::object surface_tags,
+         const DoubleArray& points, const IndexArray& tets, double size, double min_size,
+         std::map<std::int32_t, double> size_by_tag, double radius_edge, double min_dihedral, int order,
+         const std::string& surface_points_mode, py::object projection, int max_passes, int optimize_rounds,
+         py::object progress, py::object cancel) {
+        SurfaceMesh s;
+        s.xyz = points_from(surface_points, "surface_points");
+        s.tri = indices_from(surface_triangles, "surface_triangles", 3);
+        if (!surface_tags.is_none()) {
+          const IndexArray t = surface_tags.cast<IndexArray>();
+          if (t.ndim() != 1 || t.shape(0) != static_cast<py::ssize_t>(s.tri.size() / 3))
+            throw py::value_error("surface_tags must have shape (m,), one tag per surface triangle");
+          for (py::ssize_t i = 0; i < t.shape(0); ++i) s.tag.push_back(static_cast<std::int32_t>(t.data()[i]));
+        }
+        const TetMesh mesh = tetmesh_from(points, tets);
+        RefineOptions o;
+        o.size = size;
+        o.min_size = min_size;
+        o.size_by_tag = std::move(size_by_tag);
+        o.radius_edge_bound = radius_edge;
+        o.min_dihedral_deg = min_dihedral;
+        o.order = order;
+        o.max_passes = max_passes;
+        o.optimize_rounds = optimize_rounds;
+        if (surface_points_mode == "exact") o.surface_points = SurfacePoints::kExact;
+        else if (surface_points_mode == "rounded") o.surface_points = SurfacePoints::kRounded;
+        else throw py::value_error("surface_points must be 'exact' or 'rounded', got '" + surface_points_mode + "'");
+        if (!projection.is_none())
+          o.projection = [projection](const Vec3& p, std::int32_t tag, std::int32_t other) {
+            py::gil_scoped_acquire gil;
+            py::array_t<double> a(3);
+            a.mutable_data()[0] = p.x;
+            a.mutable_data()[1] = p.y;
+            a.mutable_data()[2] = p.z;
+            const auto r = projection(a, tag, other).cast<std::array<double, 3>>();
+            return Vec3{r[0], r[1], r[2]};
+          };
+        bool interrupted = false;
+        o.cancelled = [&]() {
+          py::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) {
+            PyErr_Clear();
+            interrupted = true;
+            return true;
+          }
+          return !cancel.is_none() && cancel().cast<bool>();
+        };
+        if (!progress.is_none())
+          o.progress = [&](const std::string& stage, double f) {
+            py::gil_scoped_acquire gil;
+            progress(stage, f);
+          };
+        TetMesh out;
+        RefineStats st;
+        try {
+          py::gil_scoped_release release;
+          out = refine_quality(s, mesh, o, &st);
+        } catch (const MeshingError& e) {
+          if (e.code() == ErrorCode::kCancelled && interrupted) {
+            PyErr_SetNone(PyExc_KeyboardInterrupt);
+            throw py::error_already_set();
+          }
+          throw;
+        }
+        const py::ssize_t npt = out.nodes_per_tet;
+        py::array_t<double> xyz({static_cast<py::ssize_t>(out.num_points()), static_cast<py::ssize_t>(3)});
+        std::copy(out.xyz.begin(), out.xyz.end(), xyz.mutable_data());
+        py::array_t<std::int64_t> t({static_cast<py::ssize_t>(out.num_tets()), npt});
+        std::copy(out.tet.begin(), out.tet.end(), t.mutable_data());
+        py::dict d;
+        d["points"] = st.points;
+        d["tets"] = st.tets;
+        d["nodes"] = st.nodes;
+        d["splits"] = st.splits;
+        d["surface_splits"] = st.surface_splits;
+        d["splits_no_exact_point"] = st.splits_no_exact_point;
+        d["splits_rejected"] = st.splits_rejected;
+        d["projection_rejected"] = st.projection_rejected;
+        d["collapses"] = st.collapses;
+        d["flips23"] = st.flips23;
+        d["flips32"] = st.flips32;
+        d["relocations"] = st.relocations;
+        d["size_passes"] = st.size_passes;
+        d["optimize_rounds"] = st.optimize_rounds;
+        d["long_edges_left"] = st.long_edges_left;
+        d["midnodes_projected"] = st.midnodes_projected;
+        d["midnodes_straightened"] = st.midnodes_straightened;
+        d["seconds"] = st.seconds;
+        return py::make_tuple(xyz, t, d);
+      },
+      py::arg("surface_points"), py::arg("surface_triangles"), py::arg("surface_tags"), py::arg("points"),
+      py::arg("tets"), py::arg("size") = std::numeric_limits<double>::infinity(), py::arg("min_size") = 0.0,
+      py::arg("size_by_tag") = std::map<std::int32_t, double>{}, py::arg("radius_edge") = 0.0,
+      py::arg("min_dihedral") = 0.0, py::arg("order") = 1, py::arg("surface_points_mode") = "exact",
+      py::arg("projection") = py::none(), py::arg("max_passes") = 40, py::arg("optimize_rounds") = 8,
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      "Refines a valid tet mesh of a closed surface to a size and quality (see quality_refine.h). "
+      "projection(point (3,), tag, other_tag) -> point moves new surface points. Returns (points, tets "
+      "(m, 4) or (m, 10), stats dict).");
 
   m.def(
       "orient3d",

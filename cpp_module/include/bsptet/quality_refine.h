@@ -1,0 +1,97 @@
+// FemBspTet quality stage: from the core's covering mesh to an FEM mesh of a given element size,
+// with better-shaped tets and, on request, 10-node tets.
+//
+//   TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh,
+//                          const RefineOptions& options, RefineStats* stats)
+//
+// Input: a valid linear tet mesh of `surface` with double coordinates (the core's output: input
+// points first, boundary = the input triangulation or a refinement of it). Output: a valid mesh of
+// the same surface (exact mode) or of its projection (with a projection hook), see refine_mesh.h.
+//
+// Method (local operations, as in mmg or fTetWild; each one decided exactly by RefineMesh):
+//  1. size: edges longer than split_ratio * target are split at their midpoint, longest (relative
+//     to the target) first, until none is left or max_passes; surface edges too (exact points only,
+//     or through the projection hook). The target at a point is `size`, lowered near input faces
+//     whose tag has a size in `size_by_tag`, graded (grows by at most `grading` per unit length).
+//     Edges shorter than 2 * min_size are never split: this bounds the number of points, so the
+//     stage terminates whatever the input's angles (near small input angles it stops refining and
+//     the worst tets stay there);
+//  2. optimization rounds: short edges collapsed (Steiner points only, within their support, never
+//     making the worst tet around worse), 2-3 and 3-2 flips and smoothing of interior points that
+//     raise the smallest dihedral angle locally, tets with a radius-edge ratio above the bound get
+//     their shortest edge collapsed or their longest edge split. Rounds stop when nothing changes
+//     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
+//  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
+// Deterministic: edges and tets are visited in sorted order; no randomness.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "bsptet/refine_mesh.h"
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+struct RefineOptions {
+  /// Target edge length h, model units (as FreeCAD's CharacteristicLengthMax). Infinity: no size
+  /// bound (only optimization and the per-tag sizes).
+  double size = std::numeric_limits<double>::infinity();
+  /// Smallest length refinement works at: edges shorter than 2 * min_size are never split. 0:
+  /// one eighth of the smallest target size (or 1e-3 of the bounding-box diagonal without sizes).
+  double min_size = 0;
+  /// Target size near the input triangles of a face tag (a CAD face), model units.
+  std::map<std::int32_t, double> size_by_tag;
+  /// How fast the target grows away from smaller sizes: at most `grading` per unit length.
+  double grading = 0.5;
+  /// An edge is split when longer than split_ratio * target (1.0 would make `size` a strict
+  /// maximum; about sqrt 2 matches the element counts of Gmsh and TetGen at the same size).
+  double split_ratio = 1.4;
+  /// Edges shorter than collapse_ratio * target are collapsed where a Steiner point can go (never
+  /// making the worst tet around worse, nor an edge longer than split_ratio * target).
+  double collapse_ratio = 0.5;
+  /// Tets whose circumradius / shortest edge exceeds this are refined (0: no bound). TetGen's -q
+  /// default is 2.0; 1.414 is stricter.
+  double radius_edge_bound = 0;
+  /// The optimization stops when the smallest dihedral angle reaches this (degrees; 0: it runs
+  /// until no operation helps or optimize_rounds).
+  double min_dihedral_deg = 0;
+  /// 1: linear tets; 2: 10-node tets (tet10.h).
+  int order = 1;
+  int max_passes = 40;       ///< size passes at most
+  int optimize_rounds = 8;   ///< optimization rounds at most
+  /// Moves every new surface point onto the true surface; empty: see surface_points.
+  ProjectionHook projection;
+  /// Without a hook: kExact (default) puts points on the surface only where a double lies exactly
+  /// on the facet (the output tiles the input exactly; elsewhere surface edges stay long);
+  /// kRounded takes rounded midpoints (refines every facet; boundary within rounding of the input).
+  SurfacePoints surface_points = SurfacePoints::kExact;
+  /// Called with (stage, fraction in [0, 1]); may be empty.
+  std::function<void(const std::string&, double)> progress;
+  /// Polled between steps; return true to stop (throws MeshingError with code kCancelled).
+  std::function<bool()> cancelled;
+};
+
+struct RefineStats {
+  std::int64_t points = 0, tets = 0, nodes = 0;
+  std::int64_t splits = 0;               ///< edges split (all)
+  std::int64_t surface_splits = 0;       ///< of which on the surface
+  std::int64_t splits_no_exact_point = 0;  ///< surface edges left long: no double exactly on them
+  std::int64_t splits_rejected = 0;      ///< splits refused (a new tet not positive)
+  std::int64_t projection_rejected = 0;  ///< hook results refused (non-finite)
+  std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
+  std::int64_t size_passes = 0, optimize_rounds = 0;
+  std::int64_t long_edges_left = 0;      ///< edges still longer than split_ratio * target
+  std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
+  double seconds = 0;
+};
+
+/// Refines and optimizes `mesh`, a valid linear tet mesh of `surface`. Throws InputError for bad
+/// options (naming the option), MeshingError otherwise (code kCancelled when cancelled).
+TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const RefineOptions& options,
+                       RefineStats* stats = nullptr);
+
+}  // namespace bsptet

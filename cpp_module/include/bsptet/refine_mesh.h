@@ -1,0 +1,174 @@
+// FemBspTet quality stage: an editable tetrahedral mesh of a closed input surface, changed only by
+// local operations (edge split, edge collapse, 2-3 and 3-2 flips, point relocation) that are each
+// decided EXACTLY before they are applied: every tet they create must have orient3d > 0 on the
+// double coordinates (predicates.h), and every point they put on the surface must keep the boundary
+// an exact refinement of the input triangulation (below). An operation that fails a check changes
+// nothing and returns false (or a SplitOutcome saying why); the mesh is valid after every call.
+//
+// Surface exactness, exact mode (no projection hook):
+//  * every boundary face remembers its PARENT input triangle, the one it lies on;
+//  * a point inserted on a boundary edge interior to one parent must be exactly coplanar with the
+//    parent (orient3d == 0); on an input edge (two parents) exactly collinear with the edge's ends;
+//    with the new tets positive this makes the new boundary faces tile the old ones. A rounded
+//    midpoint is generally NOT on the plane or line; when none of a few candidate doubles near the
+//    midpoint is, the edge is not split (SplitOutcome::kNoExactPoint);
+//  * boundary points move or disappear only within their support (Support below): a point inside
+//    an input triangle only onto its closed triangle, a point on an input edge only along it.
+// Rounded mode (SurfacePoints::kRounded, no hook): a new surface point is the rounded midpoint of its
+// edge, so it lies within rounding (half an ulp per coordinate) of its facet, like TetGen's.
+// Projection mode (a ProjectionHook is given): the hook moves every new surface point (chosen as the
+// rounded midpoint) onto the true surface, e.g. a CAD face. In both modes the boundary no longer
+// lies exactly on the input facets, on purpose. The boundary then no longer lies on the
+// input facets, on purpose: only the combinatorics stay a refinement (each boundary face keeps its
+// parent and face tag) and validity means positive tets, conforming faces and a closed boundary.
+// A projected point that would make a tet non-positive is rejected (the edge is not split).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+/// Where a mesh point lies with respect to the input surface.
+enum class Support : std::uint8_t {
+  kInputVertex,  ///< an input point: never moved or removed
+  kInputEdge,    ///< inside an input edge: moves only along it
+  kInputFace,    ///< inside an input triangle: moves only within its closed triangle
+  kInterior,     ///< strictly inside the solid
+};
+
+struct PointSupport {
+  Support kind = Support::kInterior;
+  Index tri = -1;        ///< kInputFace: its input triangle; kInputEdge: one triangle of the edge
+  Index other_tri = -1;  ///< kInputEdge: the other triangle of the edge
+  Index edge_from = -1;  ///< kInputEdge: the input edge's end points as MESH indices, from < to
+  Index edge_to = -1;
+};
+
+/// Moves a surface point onto the true surface: (point on the facet, face tag of its input
+/// triangle, second tag or -1) -> point. `other_tag` is not -1 only for a point on an input edge
+/// between triangles of two different tags (a CAD edge: the point belongs on both faces).
+/// Tags are the surface's `tag` entries, or -1 when the surface has none.
+using ProjectionHook = std::function<Vec3(const Vec3& point, std::int32_t tag, std::int32_t other_tag)>;
+
+/// Which points may be put on the surface when no projection hook is given.
+enum class SurfacePoints {
+  kExact,    ///< only doubles exactly on the facet or input edge (the output tiles the input exactly)
+  kRounded,  ///< the rounded midpoint (the output's boundary is within rounding of the input)
+};
+
+/// Why an edge split did not happen.
+enum class SplitOutcome {
+  kSplit,         ///< done
+  kNoEdge,        ///< (u, v) is not an edge of the mesh
+  kNoExactPoint,  ///< exact mode: no candidate double lies exactly on the boundary edge's support
+  kInverted,      ///< every candidate point made some new tet non-positive
+  kBadProjection  ///< the projection hook returned a non-finite point
+};
+
+/// Kind of a mesh edge with respect to the boundary.
+enum class EdgeKind { kInterior, kInFace, kOnInputEdge };
+
+class RefineMesh {
+ public:
+  /// Builds the editable mesh. Preconditions: `mesh` is a valid linear tet mesh of `surface` (as
+  /// mesh_check.h decides; the core's output is): every boundary face lies on one input triangle.
+  /// Input points are recognized by their coordinates. Throws MeshingError (stage "refine") naming
+  /// the face when a boundary face lies on no input triangle.
+  RefineMesh(const SurfaceMesh& surface, const TetMesh& mesh, ProjectionHook hook = {},
+             SurfacePoints surface_points = SurfacePoints::kExact);
+
+  // ---- Queries ---------------------------------------------------------------------------------
+  Index num_points() const { return static_cast<Index>(xyz_.size()); }
+  const Vec3& point(Index v) const { return xyz_[static_cast<std::size_t>(v)]; }
+  const PointSupport& support(Index v) const { return support_[static_cast<std::size_t>(v)]; }
+  bool point_alive(Index v) const { return point_alive_[static_cast<std::size_t>(v)] != 0; }
+  /// Tet slots (dead slots included: check tet_alive).
+  Index num_tet_slots() const { return static_cast<Index>(tets_.size()); }
+  bool tet_alive(Index t) const { return tet_alive_[static_cast<std::size_t>(t)] != 0; }
+  const std::array<Index, 4>& tet(Index t) const { return tets_[static_cast<std::size_t>(t)]; }
+  /// Min dihedral angle of a live tet, degrees (cached).
+  double tet_quality(Index t) const { return quality_[static_cast<std::size_t>(t)]; }
+  Index num_alive_tets() const { return alive_tets_; }
+  /// Live tets incident to point v, in increasing id order (valid until the next change).
+  const std::vector<Index>& tets_around_point(Index v);
+  /// Live tets containing both u and v, in increasing id order (empty when (u, v) is no edge).
+  std::vector<Index> tets_around_edge(Index u, Index v);
+  void tets_around_edge(Index u, Index v, std::vector<Index>& out);
+  /// Kind of edge (u, v); for boundary edges `tri_a`/`tri_b` receive the two parents (equal for
+  /// kInFace). Precondition: (u, v) is an edge.
+  EdgeKind edge_kind(Index u, Index v, Index* tri_a = nullptr, Index* tri_b = nullptr);
+  /// Every edge of the live tets once, as (min, max) pairs in lexicographic order.
+  std::vector<std::array<Index, 2>> edges() const;
+  /// Face tag of input triangle t (-1 when the surface has no tags).
+  std::int32_t tag_of(Index tri) const;
+  /// Input triangles of the surface each point lies on (input points: every triangle around it).
+  const SurfaceMesh& surface() const { return surface_; }
+
+  // ---- Operations: each checked exactly, applied only when valid --------------------------------
+  /// Splits edge (u, v) at a point near its midpoint (see the file comment for the surface rules).
+  /// `min_quality`: the split is refused (kInverted) when a new tet's min dihedral would be below
+  /// min(min_quality, the worst old tet's); pass 0 to accept any valid split. On success
+  /// `new_point` (if given) receives the new point's index.
+  SplitOutcome split_edge(Index u, Index v, double min_quality = 0, Index* new_point = nullptr);
+  /// Removes point `from` by moving it onto its neighbour `to` (tets with both are deleted). Only
+  /// for points that are not input points, within their support. Applied when every new tet is
+  /// positive, its min dihedral is at least min(min_quality, the worst old tet's), and every new
+  /// edge is at most sqrt(max_edge2) long (pass infinity for no limit).
+  bool collapse_edge(Index from, Index to, double min_quality, double max_edge2);
+  /// 2-3 flip of the interior face of tet t opposite its vertex `opposite` (0..3), applied when
+  /// valid and it raises the smallest min dihedral of the tets involved.
+  bool flip23(Index t, int opposite);
+  /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23.
+  bool flip32(Index u, Index v);
+  /// Moves interior point v to p when every tet around it stays positive and the smallest min
+  /// dihedral around it rises.
+  bool relocate_point(Index v, const Vec3& p);
+
+  // ---- Output ----------------------------------------------------------------------------------
+  /// The live tets and the points they use: input points first, at their input indices order kept
+  /// as in the mesh given to the constructor, then the others in creation order. `old_to_new`
+  /// (optional) receives the renumbering (-1 for dropped points).
+  TetMesh to_tet_mesh(std::vector<Index>* old_to_new = nullptr) const;
+  /// The boundary faces as (face, parent input triangle), vertices as mesh indices, oriented
+  /// outward, sorted.
+  std::vector<std::pair<std::array<Index, 3>, Index>> boundary_faces();
+
+ private:
+  using FaceKey = std::array<Index, 3>;
+  struct FaceKeyHash {
+    std::size_t operator()(const FaceKey& k) const;
+  };
+  static FaceKey face_key(Index a, Index b, Index c);
+
+  Index add_tet(const std::array<Index, 4>& t);
+  void kill_tet(Index t);
+  Index add_point(const Vec3& p, const PointSupport& s);
+  bool positive(const std::array<Index, 4>& t) const;
+  bool positive_with(const std::array<Index, 4>& t, Index moved, const Vec3& p) const;
+  double quality_of(const std::array<Index, 4>& t) const;
+  /// Input triangles whose closed triangle contains point v (by support).
+  bool support_allows_collapse(Index from, Index to) const;
+  bool edge_exists(Index u, Index v);
+
+  const SurfaceMesh& surface_;
+  ProjectionHook hook_;
+  SurfacePoints surface_points_;
+  std::vector<Vec3> xyz_;
+  std::vector<PointSupport> support_;
+  std::vector<char> point_alive_;
+  std::vector<std::array<Index, 4>> tets_;
+  std::vector<char> tet_alive_;
+  std::vector<double> quality_;
+  std::vector<std::vector<Index>> ball_;  ///< point -> tets (dead ids removed lazily)
+  std::unordered_map<FaceKey, Index, FaceKeyHash> boundary_;  ///< sorted face -> parent triangle
+  Index alive_tets_ = 0;
+  Index first_added_point_ = 0;
+};
+
+}  // namespace bsptet

@@ -1,0 +1,22 @@
+// FemBspTet quality stage: shape measures of one tetrahedron, in double precision. They only rank
+// candidate meshes (which flip, which position is better); they never decide validity, which is
+// the exact orient3d of predicates.h.
+#pragma once
+
+#include "bsptet/types.h"
+
+namespace bsptet {
+
+/// Smallest of the six dihedral angles of tet (a, b, c, d), in degrees. For a positively oriented
+/// tet it lies in (0, 70.53], 70.53 being the regular tet's; slivers, caps and wedges come near 0.
+/// For a flat or inverted tet the value is meaningless (callers decide orientation first).
+double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Circumradius / shortest edge of tet (a, b, c, d): 0.612 for the regular tet, large for needles,
+/// caps and wedges; infinite for a flat tet.
+double tet_radius_edge_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+/// Squared distance between two points.
+double squared_distance(const Vec3& a, const Vec3& b);
+
+}  // namespace bsptet

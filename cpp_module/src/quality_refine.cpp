@@ -1,0 +1,506 @@
+#include "bsptet/quality_refine.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <queue>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "bsptet/errors.h"
+#include "bsptet/tet10.h"
+#include "bsptet/tet_shape.h"
+
+namespace bsptet {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+void check_options(const RefineOptions& o) {
+  auto bad = [](const std::string& what) { throw InputError(ErrorCode::kBadArgument, "refine", -1, what); };
+  if (!(o.size > 0)) bad("size must be a positive length (or infinity for none), got " + std::to_string(o.size));
+  if (!(o.min_size >= 0) || !std::isfinite(o.min_size)) bad("min_size must be >= 0, got " + std::to_string(o.min_size));
+  for (const auto& [tag, s] : o.size_by_tag)
+    if (!(s > 0) || !std::isfinite(s))
+      bad("the size of face tag " + std::to_string(tag) + " must be a positive length, got " + std::to_string(s));
+  if (!(o.grading > 0)) bad("grading must be positive, got " + std::to_string(o.grading));
+  if (!(o.split_ratio >= 1) || !std::isfinite(o.split_ratio))
+    bad("split_ratio must be at least 1, got " + std::to_string(o.split_ratio));
+  if (!(o.radius_edge_bound == 0 || o.radius_edge_bound >= 0.7))
+    bad("radius_edge_bound must be 0 (off) or at least 0.7 (a regular tet has 0.612), got " +
+        std::to_string(o.radius_edge_bound));
+  if (!(o.min_dihedral_deg >= 0 && o.min_dihedral_deg < 70.5))
+    bad("min_dihedral_deg must be in [0, 70.5), got " + std::to_string(o.min_dihedral_deg));
+  if (o.order != 1 && o.order != 2) bad("order must be 1 or 2, got " + std::to_string(o.order));
+  if (o.max_passes < 0 || o.optimize_rounds < 0) bad("max_passes and optimize_rounds must be >= 0");
+}
+
+class Refiner {
+ public:
+  Refiner(RefineMesh& m, const RefineOptions& o, RefineStats& st) : m_(m), o_(o), st_(st) {}
+
+  void run() {
+    compute_targets();
+    size_phase();
+    optimize_phase(o_.optimize_rounds);
+    // Collapses and smoothing may have left some edges long again: one more short round.
+    if (o_.max_passes > 0) {
+      size_phase();
+      optimize_phase(std::min(2, o_.optimize_rounds));
+    }
+    compute_targets();
+    for (const auto& e : m_.edges())
+      if (is_long(e[0], e[1])) ++st_.long_edges_left;
+  }
+
+ private:
+  void poll(const std::string& stage, double fraction) {
+    if (o_.cancelled && o_.cancelled())
+      throw MeshingError(ErrorCode::kCancelled, "refine", -1, "cancelled during " + stage);
+    if (o_.progress) o_.progress(stage, fraction);
+  }
+
+  // ---- Sizing ---------------------------------------------------------------------------------
+  // Target size per point: `size`, lowered near tagged faces, graded along mesh edges (Dijkstra).
+  void compute_targets() {
+    const Index np = m_.num_points();
+    target_.assign(static_cast<std::size_t>(np), o_.size);
+    if (!o_.size_by_tag.empty())
+      for (const auto& [face, parent] : m_.boundary_faces()) {
+        auto it = o_.size_by_tag.find(m_.tag_of(parent));
+        if (it == o_.size_by_tag.end()) continue;
+        for (Index v : face) target_[static_cast<std::size_t>(v)] = std::min(target_[static_cast<std::size_t>(v)], it->second);
+      }
+    // Grading: t(v) <= t(u) + grading * |uv|.
+    std::vector<std::vector<Index>> nbr(static_cast<std::size_t>(np));
+    for (const auto& e : m_.edges()) {
+      nbr[static_cast<std::size_t>(e[0])].push_back(e[1]);
+      nbr[static_cast<std::size_t>(e[1])].push_back(e[0]);
+    }
+    using Item = std::pair<double, Index>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> q;
+    for (Index v = 0; v < np; ++v)
+      if (std::isfinite(target_[static_cast<std::size_t>(v)]) && !nbr[static_cast<std::size_t>(v)].empty())
+        q.push({target_[static_cast<std::size_t>(v)], v});
+    while (!q.empty()) {
+      const auto [t, v] = q.top();
+      q.pop();
+      if (t > target_[static_cast<std::size_t>(v)]) continue;
+      for (Index w : nbr[static_cast<std::size_t>(v)]) {
+        const double c = t + o_.grading * std::sqrt(squared_distance(m_.point(v), m_.point(w)));
+        if (c < target_[static_cast<std::size_t>(w)]) {
+          target_[static_cast<std::size_t>(w)] = c;
+          q.push({c, w});
+        }
+      }
+    }
+    // Where an edge could not be split (no exact point on the surface, or every candidate
+    // inverted a tet) the target is raised to that edge's length / split_ratio on the edge,
+    // decreasing by one unit per unit of distance from it: refinement then does not chase the edge
+    // with ever closer points (degrading gracefully near facets without exact points).
+    for (Index v = 0; v < np; ++v) {
+      const Vec3& p = m_.point(v);
+      double& t = target_[static_cast<std::size_t>(v)];
+      for (const Stuck& e : stuck_) {
+        if (p.x < e.lo[0] - e.reach || p.x > e.hi[0] + e.reach || p.y < e.lo[1] - e.reach ||
+            p.y > e.hi[1] + e.reach || p.z < e.lo[2] - e.reach || p.z > e.hi[2] + e.reach)
+          continue;
+        t = std::max(t, e.reach - segment_distance(p, e.a, e.b));
+      }
+    }
+    if (floor_ == 0) {
+      double smallest = kInf;
+      for (Index v = 0; v < np; ++v)
+        if (!nbr[static_cast<std::size_t>(v)].empty()) smallest = std::min(smallest, target_[static_cast<std::size_t>(v)]);
+      if (o_.min_size > 0) {
+        floor_ = o_.min_size;
+      } else if (std::isfinite(smallest)) {
+        floor_ = smallest / 8;
+      } else {
+        double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+        for (Index v = 0; v < np; ++v) {
+          const Vec3& p = m_.point(v);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], p[c]);
+            hi[c] = std::max(hi[c], p[c]);
+          }
+        }
+        floor_ = 1e-3 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
+      }
+    }
+  }
+  double target(Index v) const {
+    return static_cast<std::size_t>(v) < target_.size() ? target_[static_cast<std::size_t>(v)] : o_.size;
+  }
+  double edge_target(Index u, Index v) const { return std::min(target(u), target(v)); }
+  double length(Index u, Index v) const { return std::sqrt(squared_distance(m_.point(u), m_.point(v))); }
+  bool is_long(Index u, Index v) const {
+    const double l = length(u, v);
+    return l > o_.split_ratio * edge_target(u, v) && l > 2 * floor_;
+  }
+  void set_target(Index n, double t) {
+    if (static_cast<std::size_t>(n) >= target_.size()) target_.resize(static_cast<std::size_t>(n) + 1, o_.size);
+    target_[static_cast<std::size_t>(n)] = t;
+  }
+
+  static double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    const double wx = p.x - a.x, wy = p.y - a.y, wz = p.z - a.z;
+    const double uu = ux * ux + uy * uy + uz * uz;
+    double t = uu > 0 ? (ux * wx + uy * wy + uz * wz) / uu : 0;
+    t = std::max(0.0, std::min(1.0, t));
+    const double dx = wx - t * ux, dy = wy - t * uy, dz = wz - t * uz;
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+  }
+
+  void raise_lower(Index u, Index v) {
+    Stuck e;
+    e.a = m_.point(u);
+    e.b = m_.point(v);
+    e.reach = length(u, v) / o_.split_ratio * 1.0001;
+    for (int c = 0; c < 3; ++c) {
+      e.lo[c] = std::min(e.a[c], e.b[c]);
+      e.hi[c] = std::max(e.a[c], e.b[c]);
+    }
+    stuck_.push_back(e);
+    for (Index w : {u, v}) set_target(w, std::max(target(w), e.reach));
+  }
+
+  bool split(Index u, Index v, double min_quality) {
+    Index n = -1;
+    const SplitOutcome r = m_.split_edge(u, v, min_quality, &n);
+    if (r != SplitOutcome::kSplit && r != SplitOutcome::kNoEdge) raise_lower(u, v);
+    switch (r) {
+      case SplitOutcome::kSplit:
+        ++st_.splits;
+        if (m_.support(n).kind != Support::kInterior) ++st_.surface_splits;
+        set_target(n, 0.5 * (target(u) + target(v)));
+        return true;
+      case SplitOutcome::kNoExactPoint:
+        ++st_.splits_no_exact_point;
+        return false;
+      case SplitOutcome::kInverted:
+        ++st_.splits_rejected;
+        return false;
+      case SplitOutcome::kBadProjection:
+        ++st_.projection_rejected;
+        return false;
+      case SplitOutcome::kNoEdge:
+        return false;
+    }
+    return false;
+  }
+
+  // ---- Phase 1: size --------------------------------------------------------------------------
+  // A bound on the points the size phase may create: four times what regular tets of the smallest
+  // target would need to fill the volume, plus the input's. It only stops a runaway.
+  void set_budget() {
+    double volume = 0, smallest = kInf;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t) {
+      if (!m_.tet_alive(t)) continue;
+      const auto& q = m_.tet(t);
+      const Vec3 a = m_.point(q[0]), b = m_.point(q[1]), c = m_.point(q[2]), d = m_.point(q[3]);
+      const double bx = b.x - a.x, by = b.y - a.y, bz = b.z - a.z, cx = c.x - a.x, cy = c.y - a.y, cz = c.z - a.z,
+                   dx = d.x - a.x, dy = d.y - a.y, dz = d.z - a.z;
+      volume += (bx * (cy * dz - cz * dy) - by * (cx * dz - cz * dx) + bz * (cx * dy - cy * dx)) / 6;
+    }
+    for (double t : target_) smallest = std::min(smallest, t);
+    smallest = std::max(smallest, floor_);
+    const double regular = smallest * smallest * smallest / (6 * std::sqrt(2.0));
+    const double estimate = std::isfinite(regular) && regular > 0 ? 4 * volume / regular : 0;
+    budget_ = m_.num_points() + static_cast<Index>(std::min(estimate + 1000.0, 5e8));
+  }
+
+  void size_phase() {
+    set_budget();
+    for (int pass = 0; pass < o_.max_passes; ++pass) {
+      poll("refining to size", std::min(0.5, 0.05 * pass));
+      if (pass > 0) compute_targets();
+      std::vector<std::tuple<double, Index, Index>> todo;
+      for (const auto& e : m_.edges())
+        if (is_long(e[0], e[1])) todo.emplace_back(-length(e[0], e[1]) / edge_target(e[0], e[1]), e[0], e[1]);
+      if (todo.empty()) break;
+      std::sort(todo.begin(), todo.end());
+      std::int64_t done = 0;
+      for (const auto& [key, u, v] : todo) {
+        if (m_.num_points() >= budget_) break;
+        done += split(u, v, 0) ? 1 : 0;
+      }
+      ++st_.size_passes;
+      flip_pass(30.0);
+      if (done == 0) break;
+    }
+  }
+
+  // ---- Phase 2: optimization ------------------------------------------------------------------
+  double worst_quality() const {
+    double w = 180;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t)
+      if (m_.tet_alive(t)) w = std::min(w, m_.tet_quality(t));
+    return w;
+  }
+
+  std::vector<Index> tets_below(double q) const {
+    std::vector<std::pair<double, Index>> bad;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t)
+      if (m_.tet_alive(t) && m_.tet_quality(t) < q) bad.emplace_back(m_.tet_quality(t), t);
+    std::sort(bad.begin(), bad.end());
+    std::vector<Index> out;
+    for (const auto& b : bad) out.push_back(b.second);
+    return out;
+  }
+
+  std::int64_t flip_pass(double below) {
+    std::int64_t flips = 0;
+    std::vector<char> tried(static_cast<std::size_t>(m_.num_tet_slots()), 0);
+    for (int round = 0; round < 4; ++round) {
+      std::int64_t now = 0;
+      for (Index t : tets_below(below)) {
+        if (!m_.tet_alive(t) || (static_cast<std::size_t>(t) < tried.size() && tried[static_cast<std::size_t>(t)]))
+          continue;
+        if (static_cast<std::size_t>(t) < tried.size()) tried[static_cast<std::size_t>(t)] = 1;
+        bool done = false;
+        const auto q = m_.tet(t);
+        for (int i = 0; i < 4 && !done; ++i)
+          for (int j = i + 1; j < 4 && !done; ++j)
+            if (m_.flip32(q[i], q[j])) {
+              ++st_.flips32;
+              done = true;
+            }
+        for (int k = 0; k < 4 && !done; ++k)
+          if (m_.flip23(t, k)) {
+            ++st_.flips23;
+            done = true;
+          }
+        now += done;
+      }
+      flips += now;
+      if (now == 0) break;
+    }
+    return flips;
+  }
+
+  // Collapses short edges (one end a Steiner point), never worsening the worst tet around.
+  std::int64_t collapse_pass() {
+    std::vector<std::tuple<double, Index, Index>> todo;
+    for (const auto& e : m_.edges()) {
+      const double l = length(e[0], e[1]);
+      const double t = edge_target(e[0], e[1]);
+      if (std::isfinite(t) ? l < o_.collapse_ratio * t : false) todo.emplace_back(l / t, e[0], e[1]);
+    }
+    std::sort(todo.begin(), todo.end());
+    std::int64_t n = 0;
+    for (const auto& [r, u, v] : todo) {
+      if (!m_.point_alive(u) || !m_.point_alive(v)) continue;
+      for (const auto& [from, to] : {std::pair<Index, Index>{u, v}, std::pair<Index, Index>{v, u}}) {
+        if (m_.support(from).kind == Support::kInputVertex) continue;
+        const double lim = o_.split_ratio * target(to);
+        if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf)) {
+          ++n;
+          break;
+        }
+      }
+    }
+    st_.collapses += n;
+    return n;
+  }
+
+  // Moves interior points towards the centroid of their neighbours when it helps the worst tet.
+  std::int64_t smooth_pass(double below) {
+    std::vector<Index> pts;
+    std::vector<char> seen(static_cast<std::size_t>(m_.num_points()), 0);
+    for (Index t : tets_below(below))
+      for (Index v : m_.tet(t))
+        if (!seen[static_cast<std::size_t>(v)] && m_.support(v).kind == Support::kInterior) {
+          seen[static_cast<std::size_t>(v)] = 1;
+          pts.push_back(v);
+        }
+    std::int64_t n = 0;
+    for (Index v : pts) n += smooth_point(v) ? 1 : 0;
+    st_.relocations += n;
+    return n;
+  }
+
+  // Tries a few positions for interior point v and keeps the first that raises the worst tet
+  // around it: towards the centroid of its neighbours, then away from the face opposite v in its
+  // worst tet (lifting a flat tet).
+  bool smooth_point(Index v) {
+    if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
+    const std::vector<Index> ball = m_.tets_around_point(v);
+    Vec3 c{0, 0, 0};
+    int k = 0;
+    double mean_edge = 0, worst = 180;
+    Index worst_tet = -1;
+    for (Index t : ball) {
+      if (m_.tet_quality(t) < worst) {
+        worst = m_.tet_quality(t);
+        worst_tet = t;
+      }
+      for (Index w : m_.tet(t))
+        if (w != v) {
+          c.x += m_.point(w).x;
+          c.y += m_.point(w).y;
+          c.z += m_.point(w).z;
+          mean_edge += std::sqrt(squared_distance(m_.point(v), m_.point(w)));
+          ++k;
+        }
+    }
+    if (k == 0) return false;
+    c = {c.x / k, c.y / k, c.z / k};
+    mean_edge /= k;
+    const Vec3 p = m_.point(v);
+    for (double f : {1.0, 0.5, 0.25, 0.1}) {
+      const Vec3 q{p.x + f * (c.x - p.x), p.y + f * (c.y - p.y), p.z + f * (c.z - p.z)};
+      if (m_.relocate_point(v, q)) return true;
+    }
+    // Normal of the face opposite v in its worst tet, pointing to the side of the neighbours'
+    // centroid (v itself may lie almost on that face's plane).
+    const auto& q = m_.tet(worst_tet);
+    Vec3 f[3];
+    int j = 0;
+    for (Index w : q)
+      if (w != v) f[j++] = m_.point(w);
+    const double ux = f[1].x - f[0].x, uy = f[1].y - f[0].y, uz = f[1].z - f[0].z;
+    const double wx = f[2].x - f[0].x, wy = f[2].y - f[0].y, wz = f[2].z - f[0].z;
+    double nx = uy * wz - uz * wy, ny = uz * wx - ux * wz, nz = ux * wy - uy * wx;
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    if (!(len > 0)) return false;
+    const double side = nx * (c.x - f[0].x) + ny * (c.y - f[0].y) + nz * (c.z - f[0].z);
+    const double sgn = side >= 0 ? 1.0 : -1.0;
+    nx *= sgn / len;
+    ny *= sgn / len;
+    nz *= sgn / len;
+    for (double a : {0.3, 0.15, 0.07, 0.03, 0.01}) {
+      const Vec3 r{p.x + a * mean_edge * nx, p.y + a * mean_edge * ny, p.z + a * mean_edge * nz};
+      if (m_.relocate_point(v, r)) return true;
+    }
+    return false;
+  }
+
+  // Tets still worse than `below` after flips and smoothing: split their longest interior edge and
+  // smooth the new point (an interior point lifts slivers whose vertices all lie on the surface).
+  std::int64_t sliver_pass(double below) {
+    std::int64_t n = 0;
+    for (Index t : tets_below(below)) {
+      if (!m_.tet_alive(t)) continue;
+      const auto q = m_.tet(t);
+      std::vector<std::tuple<double, Index, Index>> e;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          if (m_.edge_kind(q[i], q[j]) == EdgeKind::kInterior) e.emplace_back(-length(q[i], q[j]), q[i], q[j]);
+      std::sort(e.begin(), e.end());
+      for (const auto& [l, a, b] : e) {
+        if (-l <= 2 * floor_) break;
+        Index p = -1;
+        if (m_.split_edge(a, b, 0, &p) != SplitOutcome::kSplit) continue;
+        ++st_.splits;
+        set_target(p, 0.5 * (target(a) + target(b)));
+        for (int k = 0; k < 3 && smooth_point(p); ++k) ++st_.relocations;
+        ++n;
+        break;
+      }
+    }
+    return n;
+  }
+
+  // Tets worse than the bound: their shortest edge collapsed (if it helps), else their longest
+  // edge split (if it is long enough).
+  std::int64_t radius_edge_pass() {
+    if (o_.radius_edge_bound <= 0) return 0;
+    std::vector<std::pair<double, Index>> bad;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t) {
+      if (!m_.tet_alive(t)) continue;
+      const auto& q = m_.tet(t);
+      const double r = tet_radius_edge_ratio(m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3]));
+      if (r > o_.radius_edge_bound) bad.emplace_back(-r, t);
+    }
+    std::sort(bad.begin(), bad.end());
+    std::int64_t n = 0;
+    for (const auto& [r, t] : bad) {
+      if (!m_.tet_alive(t)) continue;
+      const auto q = m_.tet(t);
+      std::vector<std::tuple<double, Index, Index>> e;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) e.emplace_back(length(q[i], q[j]), q[i], q[j]);
+      std::sort(e.begin(), e.end());
+      const auto [ls, a, b] = e.front();
+      bool done = false;
+      for (const auto& [from, to] : {std::pair<Index, Index>{a, b}, std::pair<Index, Index>{b, a}}) {
+        if (m_.support(from).kind == Support::kInputVertex) continue;
+        if (m_.collapse_edge(from, to, 180.0, kInf)) {
+          ++st_.collapses;
+          done = true;
+          break;
+        }
+      }
+      const auto [ll, c, d] = e.back();
+      if (!done && ll > 2 * floor_) done = split(c, d, 0);
+      n += done;
+    }
+    return n;
+  }
+
+  void optimize_phase(int rounds) {
+    const double goal = o_.min_dihedral_deg > 0 ? o_.min_dihedral_deg : 70.0;
+    for (int round = 0; round < rounds; ++round) {
+      poll("optimizing", 0.5 + 0.5 * round / std::max(1, rounds));
+      const double before = worst_quality();
+      std::int64_t changes = 0;
+      changes += collapse_pass();
+      changes += flip_pass(std::max(goal, 30.0));
+      changes += smooth_pass(std::max(goal, 30.0));
+      changes += radius_edge_pass();
+      changes += flip_pass(std::max(goal, 30.0));
+      if (round + 1 < rounds) changes += sliver_pass(std::min(goal, 15.0));
+      ++st_.optimize_rounds;
+      const double after = worst_quality();
+      (void)before;
+      if (changes == 0 || (o_.min_dihedral_deg > 0 && after >= o_.min_dihedral_deg)) break;
+    }
+  }
+
+  RefineMesh& m_;
+  const RefineOptions& o_;
+  RefineStats& st_;
+  std::vector<double> target_;
+  struct Stuck {  ///< an edge that could not be split
+    Vec3 a, b;
+    double lo[3], hi[3];
+    double reach;  ///< length / split_ratio
+  };
+  std::vector<Stuck> stuck_;
+  double floor_ = 0;
+  Index budget_ = 0;
+};
+
+}  // namespace
+
+TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const RefineOptions& options,
+                       RefineStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  check_options(options);
+  RefineStats st;
+  RefineMesh m(surface, mesh, options.projection, options.surface_points);
+  Refiner(m, options, st).run();
+  TetMesh out;
+  if (options.order == 2) {
+    SecondOrderStats so;
+    out = make_second_order(m, options.projection, &so);
+    st.midnodes_projected = so.projected;
+    st.midnodes_straightened = so.straightened;
+  } else {
+    out = m.to_tet_mesh();
+  }
+  st.tets = out.num_tets();
+  st.nodes = out.num_points();
+  st.points = m.to_tet_mesh().num_points();
+  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (stats) *stats = st;
+  return out;
+}
+
+}  // namespace bsptet

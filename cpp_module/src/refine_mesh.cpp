@@ -1,0 +1,632 @@
+#include "bsptet/refine_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <string>
+
+#include "bsptet/errors.h"
+#include "bsptet/predicates.h"
+#include "bsptet/tet_shape.h"
+
+namespace bsptet {
+
+namespace {
+
+constexpr double kImprovement = 1e-9;  // degrees: a flip or move must raise the worst angle by more
+
+bool finite(const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+Vec3 lerp(const Vec3& a, const Vec3& b, double t) {
+  return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)};
+}
+
+// Parity of the permutation taking `from` to `to` (both hold the same four values): true if even.
+bool even_permutation(std::array<Index, 4> from, const std::array<Index, 4>& to) {
+  bool even = true;
+  for (int i = 0; i < 4; ++i) {
+    if (from[i] == to[i]) continue;
+    for (int j = i + 1; j < 4; ++j)
+      if (from[j] == to[i]) {
+        std::swap(from[i], from[j]);
+        even = !even;
+        break;
+      }
+  }
+  return even;
+}
+
+// p inside the closed input triangle (a, b, c), exactly: coplanar, and on the inner side of (or
+// on) each edge line in a projection where the triangle is not degenerate.
+bool in_closed_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p) {
+  if (orient3d(a, b, c, p) != Sign::kZero) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Sign s = orient2d_projected(a, b, c, axis);
+    if (s == Sign::kZero) continue;
+    const Sign o = opposite(s);
+    return orient2d_projected(a, b, p, axis) != o && orient2d_projected(b, c, p, axis) != o &&
+           orient2d_projected(c, a, p, axis) != o;
+  }
+  return false;
+}
+
+bool collinear(const Vec3& a, const Vec3& b, const Vec3& p) {
+  for (int axis = 0; axis < 3; ++axis)
+    if (orient2d_projected(a, b, p, axis) != Sign::kZero) return false;
+  return true;
+}
+
+}  // namespace
+
+std::size_t RefineMesh::FaceKeyHash::operator()(const FaceKey& k) const {
+  std::uint64_t h = 1469598103934665603ull;
+  for (Index v : k) {
+    h ^= static_cast<std::uint64_t>(static_cast<std::uint32_t>(v));
+    h *= 1099511628211ull;
+  }
+  return static_cast<std::size_t>(h);
+}
+
+RefineMesh::FaceKey RefineMesh::face_key(Index a, Index b, Index c) {
+  FaceKey k{a, b, c};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+RefineMesh::RefineMesh(const SurfaceMesh& surface, const TetMesh& mesh, ProjectionHook hook,
+                       SurfacePoints surface_points)
+    : surface_(surface), hook_(std::move(hook)), surface_points_(surface_points) {
+  if (mesh.nodes_per_tet != 4)
+    throw MeshingError(ErrorCode::kBadArgument, "refine", -1, "refinement needs a linear (4-node) tet mesh");
+  const Index np = mesh.num_points();
+  xyz_.resize(static_cast<std::size_t>(np));
+  for (Index i = 0; i < np; ++i) xyz_[static_cast<std::size_t>(i)] = mesh.point(i);
+  support_.assign(static_cast<std::size_t>(np), PointSupport{});
+  point_alive_.assign(static_cast<std::size_t>(np), 1);
+  ball_.resize(static_cast<std::size_t>(np));
+  first_added_point_ = np;
+  for (Index t = 0; t < mesh.num_tets(); ++t) {
+    std::array<Index, 4> v{};
+    for (int k = 0; k < 4; ++k) v[k] = mesh.tet[static_cast<std::size_t>(4 * t + k)];
+    add_tet(v);
+  }
+
+  // Input points, recognized by their coordinates.
+  std::map<std::array<double, 3>, Index> surface_index;
+  for (Index i = 0; i < surface.num_points(); ++i) {
+    const Vec3 p = surface.point(i);
+    surface_index.emplace(std::array<double, 3>{p.x, p.y, p.z}, i);
+  }
+  std::vector<Index> surf_to_mesh(static_cast<std::size_t>(surface.num_points()), -1);
+  std::vector<Index> mesh_to_surf(static_cast<std::size_t>(np), -1);
+  for (Index i = 0; i < np; ++i) {
+    const Vec3& p = xyz_[static_cast<std::size_t>(i)];
+    auto it = surface_index.find({p.x, p.y, p.z});
+    if (it == surface_index.end()) continue;
+    support_[static_cast<std::size_t>(i)].kind = Support::kInputVertex;
+    surf_to_mesh[static_cast<std::size_t>(it->second)] = i;
+    mesh_to_surf[static_cast<std::size_t>(i)] = it->second;
+  }
+
+  // Boundary faces (faces of one tet) and the input triangle each lies on.
+  std::map<FaceKey, Index> input_triangle;
+  std::vector<std::vector<Index>> triangles_at(static_cast<std::size_t>(surface.num_points()));
+  for (Index t = 0; t < surface.num_triangles(); ++t) {
+    const Index* v = &surface.tri[static_cast<std::size_t>(3 * t)];
+    input_triangle.emplace(face_key(v[0], v[1], v[2]), t);
+    for (int k = 0; k < 3; ++k) triangles_at[static_cast<std::size_t>(v[k])].push_back(t);
+  }
+  std::map<FaceKey, int> face_count;
+  for (const auto& t : tets_)
+    for (int k = 0; k < 4; ++k) face_count[face_key(t[(k + 1) % 4], t[(k + 2) % 4], t[(k + 3) % 4])]++;
+  auto in_triangle = [&](Index tri, Index v) {
+    const Index* s = &surface.tri[static_cast<std::size_t>(3 * tri)];
+    return in_closed_triangle(surface.point(s[0]), surface.point(s[1]), surface.point(s[2]), point(v));
+  };
+  for (const auto& [key, count] : face_count) {
+    if (count != 1) continue;
+    Index parent = -1;
+    std::array<Index, 3> sk{};
+    bool all_input = true;
+    for (int k = 0; k < 3; ++k) {
+      sk[k] = mesh_to_surf[static_cast<std::size_t>(key[k])];
+      all_input = all_input && sk[k] >= 0;
+    }
+    if (all_input) {
+      auto it = input_triangle.find(face_key(sk[0], sk[1], sk[2]));
+      if (it != input_triangle.end()) parent = it->second;
+    }
+    if (parent < 0) {
+      std::set<Index> candidates;
+      for (int k = 0; k < 3; ++k)
+        if (sk[k] >= 0)
+          candidates.insert(triangles_at[static_cast<std::size_t>(sk[k])].begin(),
+                            triangles_at[static_cast<std::size_t>(sk[k])].end());
+      if (candidates.empty())
+        for (Index t = 0; t < surface.num_triangles(); ++t) candidates.insert(t);
+      for (Index t : candidates)
+        if (in_triangle(t, key[0]) && in_triangle(t, key[1]) && in_triangle(t, key[2])) {
+          parent = t;
+          break;
+        }
+    }
+    if (parent < 0)
+      throw MeshingError(ErrorCode::kInternal, "refine", key[0],
+                         "boundary face (" + std::to_string(key[0]) + ", " + std::to_string(key[1]) + ", " +
+                             std::to_string(key[2]) +
+                             ") lies on no input triangle: the mesh given to the refinement is not a valid "
+                             "mesh of its surface");
+    boundary_.emplace(key, parent);
+  }
+
+  // Supports of boundary Steiner points (the core may leave some with allow_boundary_steiner).
+  std::map<Index, std::set<Index>> parents_of;
+  for (const auto& [key, parent] : boundary_)
+    for (Index v : key)
+      if (support_[static_cast<std::size_t>(v)].kind != Support::kInputVertex) parents_of[v].insert(parent);
+  for (const auto& [v, parents] : parents_of) {
+    PointSupport& s = support_[static_cast<std::size_t>(v)];
+    if (parents.size() == 1) {
+      s.kind = Support::kInputFace;
+      s.tri = *parents.begin();
+      continue;
+    }
+    if (parents.size() != 2)
+      throw MeshingError(ErrorCode::kInternal, "refine", v,
+                         "boundary Steiner point " + std::to_string(v) + " lies on " +
+                             std::to_string(parents.size()) + " input triangles");
+    const Index t0 = *parents.begin(), t1 = *parents.rbegin();
+    std::vector<Index> common;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (surface.tri[static_cast<std::size_t>(3 * t0 + i)] == surface.tri[static_cast<std::size_t>(3 * t1 + j)])
+          common.push_back(surface.tri[static_cast<std::size_t>(3 * t0 + i)]);
+    if (common.size() != 2 || surf_to_mesh[static_cast<std::size_t>(common[0])] < 0 ||
+        surf_to_mesh[static_cast<std::size_t>(common[1])] < 0)
+      throw MeshingError(ErrorCode::kInternal, "refine", v,
+                         "boundary Steiner point " + std::to_string(v) + " lies on two input triangles (" +
+                             std::to_string(t0) + ", " + std::to_string(t1) + ") without a common edge");
+    s.kind = Support::kInputEdge;
+    s.tri = t0;
+    s.other_tri = t1;
+    s.edge_from = std::min(surf_to_mesh[static_cast<std::size_t>(common[0])], surf_to_mesh[static_cast<std::size_t>(common[1])]);
+    s.edge_to = std::max(surf_to_mesh[static_cast<std::size_t>(common[0])], surf_to_mesh[static_cast<std::size_t>(common[1])]);
+  }
+  // Points no tet uses are dropped from the output.
+  for (Index i = 0; i < np; ++i)
+    if (ball_[static_cast<std::size_t>(i)].empty()) point_alive_[static_cast<std::size_t>(i)] = 0;
+}
+
+std::int32_t RefineMesh::tag_of(Index tri) const {
+  return surface_.tag.empty() ? -1 : surface_.tag[static_cast<std::size_t>(tri)];
+}
+
+Index RefineMesh::add_point(const Vec3& p, const PointSupport& s) {
+  xyz_.push_back(p);
+  support_.push_back(s);
+  point_alive_.push_back(1);
+  ball_.emplace_back();
+  return static_cast<Index>(xyz_.size() - 1);
+}
+
+Index RefineMesh::add_tet(const std::array<Index, 4>& t) {
+  const Index id = static_cast<Index>(tets_.size());
+  tets_.push_back(t);
+  tet_alive_.push_back(1);
+  quality_.push_back(quality_of(t));
+  for (Index v : t) ball_[static_cast<std::size_t>(v)].push_back(id);
+  ++alive_tets_;
+  return id;
+}
+
+void RefineMesh::kill_tet(Index t) {
+  tet_alive_[static_cast<std::size_t>(t)] = 0;
+  --alive_tets_;
+}
+
+bool RefineMesh::positive(const std::array<Index, 4>& t) const {
+  return orient3d(point(t[0]), point(t[1]), point(t[2]), point(t[3])) == Sign::kPositive;
+}
+
+bool RefineMesh::positive_with(const std::array<Index, 4>& t, Index moved, const Vec3& p) const {
+  Vec3 q[4];
+  for (int k = 0; k < 4; ++k) q[k] = t[k] == moved ? p : point(t[k]);
+  return orient3d(q[0], q[1], q[2], q[3]) == Sign::kPositive;
+}
+
+double RefineMesh::quality_of(const std::array<Index, 4>& t) const {
+  return tet_min_dihedral_deg(point(t[0]), point(t[1]), point(t[2]), point(t[3]));
+}
+
+const std::vector<Index>& RefineMesh::tets_around_point(Index v) {
+  auto& b = ball_[static_cast<std::size_t>(v)];
+  b.erase(std::remove_if(b.begin(), b.end(), [&](Index t) { return !tet_alive(t); }), b.end());
+  return b;
+}
+
+void RefineMesh::tets_around_edge(Index u, Index v, std::vector<Index>& out) {
+  out.clear();
+  for (Index t : tets_around_point(u)) {
+    const auto& q = tet(t);
+    if (q[0] == v || q[1] == v || q[2] == v || q[3] == v) out.push_back(t);
+  }
+}
+
+std::vector<Index> RefineMesh::tets_around_edge(Index u, Index v) {
+  std::vector<Index> out;
+  tets_around_edge(u, v, out);
+  return out;
+}
+
+bool RefineMesh::edge_exists(Index u, Index v) {
+  for (Index t : tets_around_point(u)) {
+    const auto& q = tet(t);
+    if (q[0] == v || q[1] == v || q[2] == v || q[3] == v) return true;
+  }
+  return false;
+}
+
+EdgeKind RefineMesh::edge_kind(Index u, Index v, Index* tri_a, Index* tri_b) {
+  std::vector<std::pair<FaceKey, Index>> found;
+  for (Index t : tets_around_edge(u, v))
+    for (Index x : tet(t)) {
+      if (x == u || x == v) continue;
+      auto it = boundary_.find(face_key(u, v, x));
+      if (it == boundary_.end()) continue;
+      if (std::find_if(found.begin(), found.end(), [&](const auto& f) { return f.first == it->first; }) == found.end())
+        found.emplace_back(it->first, it->second);
+    }
+  if (found.empty()) return EdgeKind::kInterior;
+  if (found.size() != 2)
+    throw MeshingError(ErrorCode::kInternal, "refine", u,
+                       "boundary edge (" + std::to_string(u) + ", " + std::to_string(v) + ") has " +
+                           std::to_string(found.size()) + " boundary faces");
+  std::sort(found.begin(), found.end());
+  if (tri_a) *tri_a = std::min(found[0].second, found[1].second);
+  if (tri_b) *tri_b = std::max(found[0].second, found[1].second);
+  return found[0].second == found[1].second ? EdgeKind::kInFace : EdgeKind::kOnInputEdge;
+}
+
+std::vector<std::array<Index, 2>> RefineMesh::edges() const {
+  std::vector<std::array<Index, 2>> out;
+  out.reserve(static_cast<std::size_t>(alive_tets_) * 6);
+  for (Index t = 0; t < num_tet_slots(); ++t) {
+    if (!tet_alive(t)) continue;
+    const auto& q = tet(t);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) out.push_back({std::min(q[i], q[j]), std::max(q[i], q[j])});
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+SplitOutcome RefineMesh::split_edge(Index u, Index v, double min_quality, Index* new_point) {
+  const std::vector<Index> shell = tets_around_edge(u, v);
+  if (shell.empty()) return SplitOutcome::kNoEdge;
+  Index ta = -1, tb = -1;
+  const EdgeKind kind = edge_kind(u, v, &ta, &tb);
+  const Vec3 pu = point(u), pv = point(v);
+  const Vec3 mid{0.5 * (pu.x + pv.x), 0.5 * (pu.y + pv.y), 0.5 * (pu.z + pv.z)};
+
+  PointSupport s;
+  if (kind == EdgeKind::kInFace) {
+    s.kind = Support::kInputFace;
+    s.tri = ta;
+  } else if (kind == EdgeKind::kOnInputEdge) {
+    s.kind = Support::kInputEdge;
+    s.tri = ta;
+    s.other_tri = tb;
+    const PointSupport& su = support(u);
+    const PointSupport& sv = support(v);
+    if (su.kind == Support::kInputEdge) {
+      s.edge_from = su.edge_from;
+      s.edge_to = su.edge_to;
+    } else if (sv.kind == Support::kInputEdge) {
+      s.edge_from = sv.edge_from;
+      s.edge_to = sv.edge_to;
+    } else {
+      s.edge_from = std::min(u, v);
+      s.edge_to = std::max(u, v);
+    }
+  }
+
+  std::vector<Vec3> candidates;
+  if (kind == EdgeKind::kInterior) {
+    candidates = {mid, lerp(pu, pv, 0.45), lerp(pu, pv, 0.55), lerp(pu, pv, 0.35), lerp(pu, pv, 0.65)};
+  } else if (hook_) {
+    const std::int32_t tag = tag_of(ta);
+    const std::int32_t other = (kind == EdgeKind::kOnInputEdge && tag_of(tb) != tag) ? tag_of(tb) : -1;
+    const Vec3 p = hook_(mid, tag, other);
+    if (!finite(p)) return SplitOutcome::kBadProjection;
+    candidates = {p};
+  } else if (surface_points_ == SurfacePoints::kRounded) {
+    candidates = {mid, lerp(pu, pv, 0.45), lerp(pu, pv, 0.55)};
+  } else {
+    // Exact mode: the point must lie exactly on the edge's support (see refine_mesh.h).
+    const Index* t = &surface_.tri[static_cast<std::size_t>(3 * ta)];
+    const Vec3 a = surface_.point(t[0]), b = surface_.point(t[1]), c = surface_.point(t[2]);
+    std::vector<Vec3> tries = {mid};
+    for (double f : {0.5, 0.375, 0.625, 0.25, 0.75, 0.4375, 0.5625}) {
+      tries.push_back(lerp(pu, pv, f));
+      tries.push_back(lerp(pv, pu, 1.0 - f));
+    }
+    for (const Vec3& p : tries) {
+      const bool on = kind == EdgeKind::kInFace ? orient3d(a, b, c, p) == Sign::kZero : collinear(pu, pv, p);
+      if (on && std::none_of(candidates.begin(), candidates.end(), [&](const Vec3& q) { return same(p, q); }))
+        candidates.push_back(p);
+      if (candidates.size() >= 2) break;
+    }
+    if (candidates.empty()) return SplitOutcome::kNoExactPoint;
+  }
+
+  double old_min = 180;
+  for (Index t : shell) old_min = std::min(old_min, tet_quality(t));
+  const double floor = std::min(min_quality, old_min);
+  for (const Vec3& p : candidates) {
+    if (same(p, pu) || same(p, pv)) continue;
+    bool ok = true;
+    for (Index t : shell) {
+      std::array<Index, 4> a = tet(t), b = tet(t);
+      for (int k = 0; k < 4; ++k) {
+        if (a[k] == v) a[k] = -1;
+        if (b[k] == u) b[k] = -1;
+      }
+      Vec3 qa[4], qb[4];
+      for (int k = 0; k < 4; ++k) {
+        qa[k] = a[k] < 0 ? p : point(a[k]);
+        qb[k] = b[k] < 0 ? p : point(b[k]);
+      }
+      if (orient3d(qa[0], qa[1], qa[2], qa[3]) != Sign::kPositive ||
+          orient3d(qb[0], qb[1], qb[2], qb[3]) != Sign::kPositive ||
+          (floor > 0 && (tet_min_dihedral_deg(qa[0], qa[1], qa[2], qa[3]) < floor ||
+                         tet_min_dihedral_deg(qb[0], qb[1], qb[2], qb[3]) < floor))) {
+        ok = false;
+        break;
+      }
+    }
+    if (!ok) continue;
+    // Commit.
+    const Index n = add_point(p, s);
+    std::vector<std::pair<FaceKey, Index>> old_faces;
+    for (Index t : shell)
+      for (Index x : tet(t)) {
+        if (x == u || x == v) continue;
+        auto it = boundary_.find(face_key(u, v, x));
+        if (it != boundary_.end()) old_faces.emplace_back(it->first, it->second);
+      }
+    for (const auto& [key, parent] : old_faces) {
+      if (boundary_.erase(key) == 0) continue;
+      Index x = -1;
+      for (Index w : key)
+        if (w != u && w != v) x = w;
+      boundary_.emplace(face_key(u, n, x), parent);
+      boundary_.emplace(face_key(n, v, x), parent);
+    }
+    for (Index t : shell) {
+      std::array<Index, 4> a = tet(t), b = tet(t);
+      for (int k = 0; k < 4; ++k) {
+        if (a[k] == v) a[k] = n;
+        if (b[k] == u) b[k] = n;
+      }
+      kill_tet(t);
+      add_tet(a);
+      add_tet(b);
+    }
+    if (new_point) *new_point = n;
+    return SplitOutcome::kSplit;
+  }
+  return SplitOutcome::kInverted;
+}
+
+bool RefineMesh::support_allows_collapse(Index from, Index to) const {
+  const PointSupport& f = support(from);
+  const PointSupport& t = support(to);
+  switch (f.kind) {
+    case Support::kInputVertex:
+      return false;
+    case Support::kInterior:
+      return true;
+    case Support::kInputEdge:
+      return to == f.edge_from || to == f.edge_to ||
+             (t.kind == Support::kInputEdge && t.edge_from == f.edge_from && t.edge_to == f.edge_to);
+    case Support::kInputFace: {
+      if (t.kind == Support::kInputFace) return t.tri == f.tri;
+      if (t.kind == Support::kInterior) return false;
+      // `to` must be a corner of f.tri or lie on one of its edges: compare coordinates with the
+      // input triangle's corners.
+      const Index* c = &surface_.tri[static_cast<std::size_t>(3 * f.tri)];
+      auto is_corner = [&](Index m) {
+        for (int k = 0; k < 3; ++k)
+          if (same(point(m), surface_.point(c[k]))) return true;
+        return false;
+      };
+      if (t.kind == Support::kInputVertex) return is_corner(to);
+      return is_corner(t.edge_from) && is_corner(t.edge_to);
+    }
+  }
+  return false;
+}
+
+bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double max_edge2) {
+  if (!support_allows_collapse(from, to)) return false;
+  if (!edge_exists(from, to)) return false;
+  if (support(from).kind != Support::kInterior && edge_kind(from, to) == EdgeKind::kInterior) return false;
+  const std::vector<Index> ball = tets_around_point(from);  // a copy: the ball changes below
+  double old_min = 180;
+  for (Index t : ball) old_min = std::min(old_min, tet_quality(t));
+  const double floor = std::min(min_quality, old_min);
+  const Vec3 target = point(to);
+  std::vector<std::array<Index, 4>> created;
+  for (Index t : ball) {
+    std::array<Index, 4> q = tet(t);
+    if (std::find(q.begin(), q.end(), to) != q.end()) continue;
+    for (Index& w : q)
+      if (w == from) w = to;
+    if (!positive(q)) return false;
+    if (tet_min_dihedral_deg(point(q[0]), point(q[1]), point(q[2]), point(q[3])) < floor) return false;
+    for (Index w : q)
+      if (w != to && squared_distance(point(w), target) > max_edge2) return false;
+    created.push_back(q);
+  }
+  // Boundary faces around `from`: the ones with `to` vanish, the others move onto `to`.
+  std::vector<std::pair<FaceKey, Index>> faces;
+  for (Index t : ball) {
+    const auto& q = tet(t);
+    for (int k = 0; k < 4; ++k) {
+      if (q[k] == from) continue;
+      const FaceKey key = face_key(q[(k + 1) % 4], q[(k + 2) % 4], q[(k + 3) % 4]);
+      if (std::find(key.begin(), key.end(), from) == key.end()) continue;
+      auto it = boundary_.find(key);
+      if (it != boundary_.end() &&
+          std::find_if(faces.begin(), faces.end(), [&](const auto& f) { return f.first == key; }) == faces.end())
+        faces.emplace_back(key, it->second);
+    }
+  }
+  std::vector<std::pair<FaceKey, Index>> moved;
+  for (const auto& [key, parent] : faces) {
+    if (std::find(key.begin(), key.end(), to) != key.end()) continue;
+    FaceKey k = key;
+    for (Index& w : k)
+      if (w == from) w = to;
+    k = face_key(k[0], k[1], k[2]);
+    if (boundary_.count(k)) return false;
+    moved.emplace_back(k, parent);
+  }
+  for (const auto& f : faces) boundary_.erase(f.first);
+  for (const auto& f : moved) boundary_.emplace(f.first, f.second);
+  for (Index t : ball) kill_tet(t);
+  for (const auto& q : created) add_tet(q);
+  point_alive_[static_cast<std::size_t>(from)] = 0;
+  ball_[static_cast<std::size_t>(from)].clear();
+  return true;
+}
+
+bool RefineMesh::flip23(Index t, int opposite_vertex) {
+  if (!tet_alive(t)) return false;
+  const auto& q = tet(t);
+  // Faces with the opposite vertex on their positive side (types.h: outward faces reversed).
+  static const int face[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+  const Index a = q[opposite_vertex];
+  const Index x = q[face[opposite_vertex][0]], y = q[face[opposite_vertex][1]], z = q[face[opposite_vertex][2]];
+  if (boundary_.count(face_key(x, y, z))) return false;
+  Index other = -1, b = -1;
+  for (Index s : tets_around_point(x)) {
+    if (s == t) continue;
+    const auto& r0 = tet(s);
+    if (std::find(r0.begin(), r0.end(), y) == r0.end()) continue;
+    const auto& r = tet(s);
+    if (std::find(r.begin(), r.end(), z) == r.end()) continue;
+    other = s;
+    for (Index w : r)
+      if (w != x && w != y && w != z) b = w;
+  }
+  if (other < 0 || edge_exists(a, b)) return false;
+  const std::array<std::array<Index, 4>, 3> created = {{{y, x, a, b}, {z, y, a, b}, {x, z, a, b}}};
+  const double old_min = std::min(tet_quality(t), tet_quality(other));
+  for (const auto& c : created)
+    if (!positive(c) || quality_of(c) <= old_min + kImprovement) return false;
+  kill_tet(t);
+  kill_tet(other);
+  for (const auto& c : created) add_tet(c);
+  return true;
+}
+
+bool RefineMesh::flip32(Index u, Index v) {
+  const std::vector<Index> shell = tets_around_edge(u, v);
+  if (shell.size() != 3) return false;
+  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
+  std::array<Index, 4> first = tet(shell[0]);
+  Index p = -1, q = -1;
+  for (Index w : first)
+    if (w != u && w != v) (p < 0 ? p : q) = w;
+  if (!even_permutation(first, {u, v, p, q})) std::swap(p, q);
+  const Index y = p, x = q;
+  Index z = -1;
+  for (std::size_t i = 1; i < 3; ++i)
+    for (Index w : tet(shell[i]))
+      if (w != u && w != v && w != x && w != y) z = w;
+  if (z < 0) return false;
+  // The ring must be closed: tets {u,v,x,y}, {u,v,y,z}, {u,v,z,x}.
+  for (Index s : shell) {
+    int hits = 0;
+    for (Index w : tet(s)) hits += (w == x) + (w == y) + (w == z);
+    if (hits != 2) return false;
+  }
+  if (!tets_around_edge(x, y).empty()) {
+    for (Index s : tets_around_edge(x, y)) {
+      const auto& r = tet(s);
+      if (std::find(r.begin(), r.end(), z) != r.end()) return false;  // face (x, y, z) exists
+    }
+  }
+  const std::array<std::array<Index, 4>, 2> created = {{{x, y, z, u}, {y, x, z, v}}};
+  double old_min = 180;
+  for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
+  for (const auto& c : created)
+    if (!positive(c) || quality_of(c) <= old_min + kImprovement) return false;
+  for (Index s : shell) kill_tet(s);
+  for (const auto& c : created) add_tet(c);
+  return true;
+}
+
+bool RefineMesh::relocate_point(Index v, const Vec3& p) {
+  if (support(v).kind != Support::kInterior || !finite(p)) return false;
+  const std::vector<Index>& ball = tets_around_point(v);
+  double old_min = 180;
+  for (Index t : ball) old_min = std::min(old_min, tet_quality(t));
+  std::vector<double> q(ball.size());
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const auto& t = tet(ball[i]);
+    if (!positive_with(t, v, p)) return false;
+    Vec3 c[4];
+    for (int k = 0; k < 4; ++k) c[k] = t[k] == v ? p : point(t[k]);
+    q[i] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
+    if (q[i] <= old_min + kImprovement) return false;
+  }
+  xyz_[static_cast<std::size_t>(v)] = p;
+  for (std::size_t i = 0; i < ball.size(); ++i) quality_[static_cast<std::size_t>(ball[i])] = q[i];
+  return true;
+}
+
+TetMesh RefineMesh::to_tet_mesh(std::vector<Index>* old_to_new) const {
+  std::vector<Index> renum(xyz_.size(), -1);
+  for (Index t = 0; t < num_tet_slots(); ++t)
+    if (tet_alive(t))
+      for (Index v : tet(t)) renum[static_cast<std::size_t>(v)] = 0;
+  TetMesh out;
+  Index next = 0;
+  for (std::size_t i = 0; i < xyz_.size(); ++i) {
+    if (renum[i] < 0) continue;
+    renum[i] = next++;
+    out.xyz.insert(out.xyz.end(), {xyz_[i].x, xyz_[i].y, xyz_[i].z});
+  }
+  for (Index t = 0; t < num_tet_slots(); ++t)
+    if (tet_alive(t))
+      for (Index v : tet(t)) out.tet.push_back(renum[static_cast<std::size_t>(v)]);
+  if (old_to_new) *old_to_new = std::move(renum);
+  return out;
+}
+
+std::vector<std::pair<std::array<Index, 3>, Index>> RefineMesh::boundary_faces() {
+  std::vector<std::pair<std::array<Index, 3>, Index>> out;
+  out.reserve(boundary_.size());
+  for (const auto& [key, parent] : boundary_) {
+    std::array<Index, 3> face = key;
+    for (Index t : tets_around_edge(key[0], key[1])) {
+      const auto& q = tet(t);
+      int k = 0;
+      while (k < 4 && (q[k] == key[0] || q[k] == key[1] || q[k] == key[2])) ++k;
+      if (k == 4 || std::find(q.begin(), q.end(), key[2]) == q.end()) continue;
+      // Outward face opposite q[k] (types.h).
+      static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+      face = {q[outward[k][0]], q[outward[k][1]], q[outward[k][2]]};
+    }
+    out.emplace_back(face, parent);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace bsptet

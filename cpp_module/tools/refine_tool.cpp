@@ -1,0 +1,116 @@
+// bsptet_refine: the core then the quality stage, from the command line (debugging, benchmarks;
+// users run `fembsptet mesh --size H`). Meshes one OFF surface, refines it, checks the result
+// exactly and prints one line of figures.
+//
+//   bsptet_refine SURFACE.off [--size H | --size-diag N] [--min-size L] [--radius-edge B]
+//                 [--min-dihedral D] [--split-ratio R] [--rounded] [--write STEM]
+//
+// --size-diag N sets H to the bounding-box diagonal / N. Exit: 0 valid, 1 error or invalid, 2 bad input.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <algorithm>
+#include <array>
+#include <map>
+#include <string>
+
+#include "bsptet/errors.h"
+#include "bsptet/mesh_check.h"
+#include "bsptet/mesh_io.h"
+#include "bsptet/mesher.h"
+#include "bsptet/quality_refine.h"
+
+using namespace bsptet;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr,
+                 "usage: %s SURFACE.off [--size H | --size-diag N] [--min-size L] [--radius-edge B] "
+                 "[--min-dihedral D] [--split-ratio R] [--write STEM]\n",
+                 argv[0]);
+    return 2;
+  }
+  RefineOptions o;
+  double size_diag = 0;
+  std::string stem;
+  for (int i = 2; i < argc; ++i) {
+    auto value = [&]() {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", argv[i]);
+        std::exit(2);
+      }
+      return std::atof(argv[++i]);
+    };
+    if (!std::strcmp(argv[i], "--size")) o.size = value();
+    else if (!std::strcmp(argv[i], "--size-diag")) size_diag = value();
+    else if (!std::strcmp(argv[i], "--min-size")) o.min_size = value();
+    else if (!std::strcmp(argv[i], "--radius-edge")) o.radius_edge_bound = value();
+    else if (!std::strcmp(argv[i], "--min-dihedral")) o.min_dihedral_deg = value();
+    else if (!std::strcmp(argv[i], "--split-ratio")) o.split_ratio = value();
+    else if (!std::strcmp(argv[i], "--collapse-ratio")) o.collapse_ratio = value();
+    else if (!std::strcmp(argv[i], "--rounded")) o.surface_points = SurfacePoints::kRounded;
+    else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", argv[i]);
+      return 2;
+    }
+  }
+  try {
+    const SurfaceMesh s = read_off(argv[1]);
+    if (size_diag > 0) {
+      double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      for (Index i = 0; i < s.num_points(); ++i)
+        for (int c = 0; c < 3; ++c) {
+          lo[c] = std::fmin(lo[c], s.point(i)[c]);
+          hi[c] = std::fmax(hi[c], s.point(i)[c]);
+        }
+      o.size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2])) / size_diag;
+    }
+    MeshStats cst;
+    const TetMesh core = tetrahedralize(s, MeshOptions{}, &cst);
+    const MeshCheckReport before = check_mesh(s, core);
+    RefineStats st;
+    const TetMesh m = refine_quality(s, core, o, &st);
+    // Rounded mode: the boundary is checked against itself (see refine_mesh.h).
+    SurfaceMesh reference = s;
+    if (o.surface_points == SurfacePoints::kRounded) {
+      reference.xyz = m.xyz;
+      reference.tri.clear();
+      std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
+      for (Index t = 0; t < m.num_tets(); ++t) {
+        const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
+        const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+        for (const auto& f : outward) {
+          std::array<Index, 3> face{q[f[0]], q[f[1]], q[f[2]]}, key = face;
+          std::sort(key.begin(), key.end());
+          if (!faces.erase(key)) faces.emplace(key, face);
+        }
+      }
+      for (const auto& [key, face] : faces) reference.tri.insert(reference.tri.end(), face.begin(), face.end());
+    }
+    const MeshCheckReport r = check_mesh(reference, m);
+    std::printf("%s: %s h %.6g core tets %d min_dihedral %.2f -> tets %d points %d min_dihedral %.2f p1 %.2f "
+                "median %.2f max_radius_edge %.3g splits %lld (surface %lld, no exact point %lld, rejected %lld) "
+                "collapses %lld flips %lld/%lld moves %lld long_left %lld core_s %.3f refine_s %.3f\n",
+                argv[1], r.valid ? "VALID" : "INVALID", o.size, core.num_tets(), before.quality.min_dihedral_deg,
+                m.num_tets(), m.num_points(), r.quality.min_dihedral_deg, r.quality.p1_dihedral_deg,
+                r.quality.median_dihedral_deg, r.quality.max_radius_edge_ratio, static_cast<long long>(st.splits),
+                static_cast<long long>(st.surface_splits), static_cast<long long>(st.splits_no_exact_point),
+                static_cast<long long>(st.splits_rejected), static_cast<long long>(st.collapses),
+                static_cast<long long>(st.flips23), static_cast<long long>(st.flips32),
+                static_cast<long long>(st.relocations), static_cast<long long>(st.long_edges_left),
+                cst.seconds_total, st.seconds);
+    for (const auto& msg : r.messages) std::printf("  %s\n", msg.c_str());
+    if (!stem.empty()) write_tetgen(stem, m);
+    return r.valid ? 0 : 1;
+  } catch (const InputError& e) {
+    std::printf("%s: INPUT ERROR %s\n", argv[1], e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::printf("%s: ERROR %s\n", argv[1], e.what());
+    return 1;
+  }
+}

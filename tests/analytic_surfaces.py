@@ -1,0 +1,97 @@
+"""Closed triangle surfaces of analytic solids, with their exact surface and a projection hook,
+for the quality-stage tests (no data files: generated, deterministic)."""
+
+import math
+
+import numpy as np
+
+from FemBspTet.mesh_types import Surface
+
+
+def icosphere(radius=1.0, subdivisions=1):
+    """A sphere of `radius` about the origin: a subdivided icosahedron, vertices on the sphere
+    (up to rounding), outward CCW, one face tag (0)."""
+    t = (1.0 + 5 ** 0.5) / 2.0
+    v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+         (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    f = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+         (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+         (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    pts = [np.array(p, float) / np.linalg.norm(p) for p in v]
+    for _ in range(subdivisions):
+        mid = {}
+        nf = []
+
+        def middle(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in mid:
+                m = pts[a] + pts[b]
+                pts.append(m / np.linalg.norm(m))
+                mid[key] = len(pts) - 1
+            return mid[key]
+
+        for a, b, c in f:
+            ab, bc, ca = middle(a, b), middle(b, c), middle(c, a)
+            nf += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        f = nf
+    p = np.array(pts) * radius
+    return Surface(p, np.array(f), np.zeros(len(f), np.int32), source="icosphere")
+
+
+def sphere_projection(radius):
+    def project(point, tag, other_tag):
+        p = np.asarray(point, float)
+        return p * (radius / np.linalg.norm(p))
+    return project
+
+
+def sphere_distance(points, radius):
+    return np.abs(np.linalg.norm(points, axis=1) - radius)
+
+
+def cylinder(radius=1.0, height=2.0, segments=12):
+    """A closed cylinder about the z axis from z = 0 to z = height: side tag 0, bottom cap tag 1,
+    top cap tag 2 (caps fanned from their centre). Outward CCW."""
+    ang = [2 * math.pi * k / segments for k in range(segments)]
+    ring = [(radius * math.cos(a), radius * math.sin(a)) for a in ang]
+    pts = [(x, y, 0.0) for x, y in ring] + [(x, y, height) for x, y in ring]
+    pts += [(0.0, 0.0, 0.0), (0.0, 0.0, height)]
+    cb, ct = 2 * segments, 2 * segments + 1
+    tris, tags = [], []
+    for k in range(segments):
+        a, b = k, (k + 1) % segments
+        tris += [(a, b, b + segments), (a, b + segments, a + segments)]
+        tags += [0, 0]
+        tris.append((cb, b, a))
+        tags.append(1)
+        tris.append((ct, a + segments, b + segments))
+        tags.append(2)
+    return Surface(np.array(pts), np.array(tris), np.array(tags, np.int32), source="cylinder")
+
+
+def cylinder_projection(radius, height):
+    def onto(p, tag):
+        p = np.array(p, float)
+        if tag == 0:
+            r = math.hypot(p[0], p[1])
+            p[0], p[1] = p[0] * radius / r, p[1] * radius / r
+        elif tag == 1:
+            p[2] = 0.0
+        elif tag == 2:
+            p[2] = height
+        return p
+
+    def project(point, tag, other_tag):
+        p = onto(point, tag)
+        return onto(p, other_tag) if other_tag >= 0 else p
+    return project
+
+
+def cylinder_distance(points, radius, height):
+    """Distance of each point to the closed cylinder's surface (side and caps)."""
+    r = np.hypot(points[:, 0], points[:, 1])
+    z = points[:, 2]
+    side = np.where((z >= 0) & (z <= height), np.abs(r - radius), np.inf)
+    bottom = np.where(r <= radius, np.abs(z), np.inf)
+    top = np.where(r <= radius, np.abs(z - height), np.inf)
+    return np.minimum(side, np.minimum(bottom, top))
