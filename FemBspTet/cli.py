@@ -341,13 +341,15 @@ def _cmd_benchmark(args):
 
     _positive_option(args.divisions, "--divisions")
     _positive_option(args.timeout, "--timeout")
+    if not os.path.isdir(os.path.dirname(os.path.abspath(args.report))):
+        raise InputError("the output directory does not exist", where=args.report)
     paths = model_paths(args.models)
     if not paths:
         raise InputError("no models found (" + ", ".join(MODEL_EXTENSIONS_TEXT) + ")")
     meshers = tuple(m for m in args.meshers.split(",") if m) if args.meshers else MESHERS
     entries = run_benchmark(paths, timeout=args.timeout, divisions=args.divisions,
                             meshers=meshers, log=lambda line: print(line, flush=True))
-    command = "fembsptet benchmark " + " ".join(args.raw_argv)
+    command = "fembsptet " + " ".join(args.raw_argv)
     png = write_report(args.report, entries, command=command)
     print(f"report: {args.report}" + (f" (+ {png})" if png else ""))
     return 0

@@ -153,7 +153,10 @@ def environment():
     dirty = _first_line(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"])
     from .gmsh_backend import gmsh_version
 
-    return [("CPU", f"{cpu} ({os.cpu_count()} logical cores)"), ("RAM", ram),
+    import time
+
+    return [("date", time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())),
+            ("CPU", f"{cpu} ({os.cpu_count()} logical cores)"), ("RAM", ram),
             ("OS", f"Debian {debian}, {platform.system()} {platform.release()}"),
             ("Python", platform.python_version()),
             ("TetGen", _first_line(["dpkg-query", "-W", "-f", "${Version}", "tetgen"])
@@ -294,16 +297,54 @@ def plot_benchmark(path, entries, cols=5):
     return True
 
 
-def write_report(path, entries, command="", png=True):
-    """Writes the markdown report (and ``<stem>.png`` beside it). Returns the PNG path or None."""
+def save_entries(path, entries, command, env):
+    """Every figure of the run as JSON (``<stem>.json`` beside the report), so the report can be
+    made again (:func:`load_entries`) without running the meshers again."""
+    import json
+
     from ..atomic_file import atomic_output
 
+    data = {"command": command, "environment": env,
+            "entries": [{"name": e.name, "path": e.path, "error": e.error,
+                         "comparison": None if e.comparison is None else e.comparison.to_dict()}
+                        for e in entries]}
+    with atomic_output(path) as f:
+        json.dump(data, f)
+
+
+def load_entries(path):
+    """``(entries, command, env)`` from a file written by :func:`save_entries`."""
+    import json
+
+    from .comparison import Comparison, Row
+
+    with open(path) as f:
+        data = json.load(f)
+    fields = {f.name for f in dataclasses.fields(Row)}
+    entries = []
+    for d in data["entries"]:
+        c = d["comparison"]
+        if c is not None:
+            c = Comparison(**{**c, "rows": [Row(**{k: v for k, v in r.items() if k in fields})
+                                            for r in c["rows"]]})
+        entries.append(Entry(d["name"], d["path"], c, d["error"]))
+    return entries, data["command"], [tuple(x) for x in data["environment"]]
+
+
+def write_report(path, entries, command="", png=True, env=None):
+    """Writes the markdown report, ``<stem>.png`` (histograms) and ``<stem>.json`` (every
+    figure) beside it. Returns the PNG path or None."""
+    from ..atomic_file import atomic_output
+
+    env = environment() if env is None else env
+    save_entries(os.path.splitext(path)[0] + ".json", entries, command, env)
     png_path = None
     if png:
         png_path = os.path.splitext(path)[0] + ".png"
         if not plot_benchmark(png_path, entries):
             png_path = None
-    text = report_markdown(entries, command, os.path.basename(png_path) if png_path else None)
+    text = report_markdown(entries, command, os.path.basename(png_path) if png_path else None,
+                           env)
     with atomic_output(path) as f:
         f.write(text)
     return png_path
