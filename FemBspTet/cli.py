@@ -217,24 +217,10 @@ def _cmd_mesh(args):
 
 
 def _tetgen_table(surfaces, stats):
-    """Our counts beside `tetgen -pY` on the same surface(s)."""
-    from .compare.tetgen_backend import run_tetgen, tetgen_available
+    """Our counts beside `tetgen -pY` on the same surface(s) (compare/comparison.py)."""
+    from .compare.comparison import format_rows, row_from_stats, tetgen_pY_row
 
-    if not tetgen_available():
-        return "tetgen is not installed: no comparison (run scripts/setup.sh)"
-    runs = [run_tetgen(s, "pY") for s in surfaces]
-    tg_points = sum(len(r.mesh.points) for r in runs)
-    tg_tets = sum(len(r.mesh.tets) for r in runs)
-    tg_steiner = sum(r.steiner_points for r in runs)
-    tg_seconds = sum(r.seconds for r in runs)
-    rows = [
-        ("", "FemBspTet", "tetgen -pY"),
-        ("points", stats["points"], tg_points),
-        ("tets", stats["tets"], tg_tets),
-        ("steiner points", stats["steiner_points"], tg_steiner),
-        ("seconds", f"{stats['seconds_total']:.3f}", f"{tg_seconds:.3f}"),
-    ]
-    return "\n".join(f"{a:<16s}{b!s:>12s}{c!s:>14s}" for a, b, c in rows)
+    return format_rows([row_from_stats(stats), tetgen_pY_row(surfaces)])
 
 
 def _summary(report):

@@ -119,6 +119,7 @@ try:
         facts["tets_after_mesh"] = obj.FemMesh.VolumeCount
         facts["result_nodes_property"] = obj.Nodes
         facts["tetgen_tets_property"] = obj.TetGenTetrahedra
+        facts["tetgen_min_dihedral_property"] = obj.TetGenMinDihedralAngle
         facts["mesh_status"] = obj.MeshStatus
         shot = os.environ.get("FEMBSPTET_GUI_SCREENSHOT")
         if shot:

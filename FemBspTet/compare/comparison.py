@@ -373,17 +373,49 @@ def row_label(row):
     return {OURS: "FemBspTet"}.get(row.mesher, row.command.split(" (")[0])
 
 
+def row_dict(row: Row) -> dict:
+    """``row`` as a JSON-ready dict without the histogram (the FreeCAD object keeps this)."""
+    d = dataclasses.asdict(row)
+    d.pop("dihedral_histogram")
+    d["steiner_points"] = row.steiner_points
+    return d
+
+
+def row_from_stats(stats, command="fembsptet") -> Row:
+    """Our row from the stats of a run made in this process (``core.tetrahedralize`` and the
+    CLI's ``seconds_total``): the mesh was checked exactly against the input before it was
+    returned, and its boundary has no Steiner point unless allowed."""
+    boundary = int(stats.get("boundary_steiner_points") or 0)
+    return Row(mesher=OURS, command=command, nodes=int(stats["points"]), tets=int(stats["tets"]),
+               steiner_interior=int(stats["steiner_points"]) - boundary,
+               steiner_boundary=boundary, min_dihedral_deg=stats.get("min_dihedral_deg"),
+               p1_dihedral_deg=stats.get("p1_dihedral_deg"),
+               median_dihedral_deg=stats.get("median_dihedral_deg"),
+               max_radius_edge_ratio=stats.get("max_radius_edge_ratio"),
+               seconds=stats.get("seconds_total"), valid=bool(stats.get("valid")),
+               checks=CHECKS_AGAINST_INPUT if not boundary else CHECKS_AGAINST_OWN_BOUNDARY)
+
+
+def format_rows(rows, keys=None) -> str:
+    """``rows`` as a text table, one line per mesher, the columns ``keys`` (default all)."""
+    columns = [c for c in COLUMNS if keys is None or c[0] in keys]
+    heads = ["mesher"] + [h for _k, h, _f in columns]
+    body = [[row_label(r)] + [r.cell(k) for k, _h, _f in columns] for r in rows]
+    widths = [max(len(x) for x in col) for col in zip(heads, *body)]
+    fmt_row = "  ".join(("{:<%d}" if i == 0 else "{:>%d}") % w for i, w in enumerate(widths))
+    lines = [fmt_row.format(*heads)] + [fmt_row.format(*b) for b in body]
+    for r in rows:
+        if r.status != "ok":
+            lines.append(f"{row_label(r)}: {r.status}: {r.message}")
+    return "\n".join(lines)
+
+
 def format_table(result: Comparison) -> str:
     """The comparison as a text table, with the notes it needs to be read."""
-    heads = ["mesher"] + [h for _k, h, _f in COLUMNS]
-    body = [[row_label(r)] + [r.cell(k) for k, _h, _f in COLUMNS] for r in result.rows]
-    widths = [max(len(x) for x in col) for col in zip(heads, *body)]
     lines = [f"{result.source}: {result.input_points} points, {result.input_triangles} "
              f"triangles, {result.solids} solid(s); size: "
-             + ("none (default meshes)" if result.size is None else f"{result.size:g}")]
-    fmt_row = "  ".join(("{:<%d}" if i == 0 else "{:>%d}") % w for i, w in enumerate(widths))
-    lines.append(fmt_row.format(*heads))
-    lines += [fmt_row.format(*b) for b in body]
+             + ("none (default meshes)" if result.size is None else f"{result.size:g}"),
+             format_rows(result.rows)]
     for r in result.rows:
         if r.status != "ok":
             lines.append(f"{row_label(r)}: {r.status}: {r.message}")
