@@ -331,7 +331,8 @@ def _cmd_benchmark(args):
         raise InputError("the output directory does not exist", where=args.report)
     paths = model_paths(args.models)
     if not paths:
-        raise InputError("no models found (" + ", ".join(MODEL_EXTENSIONS_TEXT) + ")")
+        raise InputError("no models found (" + ", ".join(SURFACE_EXTENSIONS + CAD_EXTENSIONS)
+                         + ")")
     meshers = tuple(m for m in args.meshers.split(",") if m) if args.meshers else MESHERS
     entries = run_benchmark(paths, timeout=args.timeout, divisions=args.divisions,
                             meshers=meshers, log=lambda line: print(line, flush=True))
@@ -339,9 +340,6 @@ def _cmd_benchmark(args):
     png = write_report(args.report, entries, command=command)
     print(f"report: {args.report}" + (f" (+ {png})" if png else ""))
     return 0
-
-
-MODEL_EXTENSIONS_TEXT = SURFACE_EXTENSIONS + CAD_EXTENSIONS
 
 
 def build_parser():

@@ -16,13 +16,13 @@ import platform
 import statistics
 import subprocess
 
+from ..cli import CAD_EXTENSIONS, SURFACE_EXTENSIONS
 from ..errors import BspTetError
 from .comparison import COLUMNS, GMSH, OURS, TETGEN_PY, compare, draw_histograms, row_label
 from .process import DEFAULT_TIMEOUT
 
 #: Extensions the benchmark takes from a folder (the inputs of ``fembsptet mesh``).
-MODEL_EXTENSIONS = (".off", ".stl", ".obj", ".ply", ".step", ".stp", ".brep", ".brp", ".iges",
-                    ".igs")
+MODEL_EXTENSIONS = SURFACE_EXTENSIONS + CAD_EXTENSIONS
 
 
 @dataclasses.dataclass
@@ -33,13 +33,14 @@ class Entry:
     error: str = ""  #: why the input could not be read or tessellated
 
 
-def model_paths(args):
-    """Files named in ``args`` and the model files in the folders named there, sorted."""
+def model_paths(args, extensions=MODEL_EXTENSIONS):
+    """Files named in ``args`` and the files of the folders named there whose extension is one
+    of ``extensions``, each folder's sorted."""
     paths = []
     for a in args:
         if os.path.isdir(a):
             paths += sorted(os.path.join(a, f) for f in os.listdir(a)
-                            if os.path.splitext(f)[1].lower() in MODEL_EXTENSIONS)
+                            if os.path.splitext(f)[1].lower() in extensions)
         else:
             paths.append(a)
     return paths
