@@ -99,7 +99,8 @@ def test_compare_with_size_adds_tetgen_quality_and_plots(cli, tmp_path):
     rows = {r["mesher"]: r for r in data["rows"]}
     v = 0.75 ** 3 / (6 * 2 ** 0.5)
     assert rows["tetgen-pq"]["command"] == f"tetgen -pq1.414a{v:.6g}"
-    assert rows["gmsh"]["command"].startswith("gmsh -3 (CharacteristicLengthMax 0.75")
+    assert rows["gmsh"]["command"] == "gmsh -3 (surface remeshed, CharacteristicLengthMax 0.75)"
+    assert rows["gmsh"]["tets"] > 10 * rows["tetgen-pY"]["tets"]  # the size is honoured
     pq = rows["tetgen-pq"]
     assert pq["steiner_boundary"] > 0 and "closed boundary" in pq["checks"]  # not "invalid"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

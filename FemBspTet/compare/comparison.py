@@ -12,8 +12,11 @@ start to exit, peak resident memory of that process):
 * ``tetgen-pY``: ``tetgen -pY`` (no Steiner point on the surface, no quality bound);
 * ``tetgen-pq``: ``tetgen -pq1.414a<V>``, V = h^3 / (6 sqrt 2) the volume of the regular tet of
   edge h (only with ``size``);
-* ``gmsh``: Gmsh's 3D mesher on the same triangulation, ``CharacteristicLengthMax`` = ``size``,
-  or without a size the mean edge length of the input surface (the table says which).
+* ``gmsh``: Gmsh's 3D mesher on the same triangulation. Without ``size`` it fills the given
+  triangulation (``CharacteristicLengthMax`` = the mean input edge length; Gmsh sizes the
+  interior from the surface anyway); with ``size`` it first remeshes the surface at that size
+  (its ``ClassifySurfaces`` + ``CreateGeometry``), as ``tetgen -pq`` splits surface triangles:
+  see :mod:`.gmsh_backend`. The table says which.
 
 A CAD input is tessellated once (by the caller) and every mesher gets the same triangles; a
 solid of several solids is meshed solid by solid and the counts are summed.
@@ -268,14 +271,15 @@ def _run_tetgen(surfaces, switches, timeout, workdir):
     return meshes, seconds, rss, [st + ext for st in stems for ext in (".node", ".ele")]
 
 
-def _run_gmsh(surfaces, size, timeout, workdir):
+def _run_gmsh(surfaces, size, timeout, workdir, remesh_surface):
     from .gmsh_backend import gmsh_available, run_gmsh
 
     if not gmsh_available():
         raise MesherFailed("skipped", "gmsh is not installed (Debian package gmsh)")
 
     def one(s, t, name):
-        return run_gmsh(s, size, timeout=t, keep_dir=workdir, name=name)
+        return run_gmsh(s, size, timeout=t, keep_dir=workdir, name=name,
+                        remesh_surface=remesh_surface)
 
     return _run_per_solid(one, surfaces, timeout)
 
@@ -299,7 +303,7 @@ def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, our
     else:
         from .gmsh_backend import gmsh_command
 
-        command = gmsh_command(gmsh_size)
+        command = gmsh_command(gmsh_size, remesh_surface=size is not None)
     row = Row(mesher=mesher, command=command)
     try:
         if mesher == OURS:
@@ -310,7 +314,7 @@ def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, our
                 surfaces, command.split(" -")[1], timeout, workdir)
         else:
             meshes, row.seconds, row.peak_rss_mb, files = _run_gmsh(
-                surfaces, gmsh_size, timeout, workdir)
+                surfaces, gmsh_size, timeout, workdir, remesh_surface=size is not None)
         row.mesh_files = [] if own_dir else files
         for k, v in evaluate(surfaces, meshes).items():
             setattr(row, k, v)
@@ -334,9 +338,9 @@ def compare(surfaces, size=None, timeout=DEFAULT_TIMEOUT, workdir=None, meshers=
     """Runs the meshers on ``surfaces`` (a Surface or a list, one per solid). Returns a
     :class:`Comparison`; never raises for a mesher (its row says what happened).
 
-    ``size``: None compares the default meshes (``tetgen -pY``, no ``-pq`` row; Gmsh at the mean
-    input edge length); H runs our quality stage at size H, ``tetgen -pq1.414a<V(H)>`` and Gmsh at
-    H. ``workdir``: keep every mesher's files there (else a temporary directory, removed).
+    ``size``: None compares the default meshes (``tetgen -pY``, no ``-pq`` row; Gmsh filling the
+    triangulation, at the mean input edge length); H runs our quality stage at size H,
+    ``tetgen -pq1.414a<V(H)>`` and Gmsh at H with the surface remeshed. ``workdir``: keep every mesher's files there (else a temporary directory, removed).
     ``ours_options``: more options for our mesher (e.g. ``{"surface_points": "rounded"}``).
     """
     from .gmsh_backend import mean_edge_length
@@ -345,7 +349,7 @@ def compare(surfaces, size=None, timeout=DEFAULT_TIMEOUT, workdir=None, meshers=
         surfaces = [surfaces]
     surfaces = list(surfaces)
     if size is not None:
-        gmsh_size, note = float(size), "--size"
+        gmsh_size, note = float(size), "--size (surface remeshed by Gmsh)"
     else:
         all_edges = sum(3 * len(s.triangles) for s in surfaces)
         gmsh_size = sum(mean_edge_length(s) * 3 * len(s.triangles) for s in surfaces) / all_edges
@@ -421,7 +425,7 @@ def format_table(result: Comparison) -> str:
             lines.append(f"{row_label(r)}: {r.status}: {r.message}")
     gmsh = result.row(GMSH)
     if gmsh is not None:
-        lines.append(f"gmsh: {gmsh.command}, size from the {result.gmsh_size_note}")
+        lines.append(f"gmsh: {gmsh.command}; size: {result.gmsh_size_note}")
     for r in result.rows:
         if r.status == "ok":
             lines.append(f"valid ({row_label(r)}): {r.checks}"

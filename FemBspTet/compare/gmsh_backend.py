@@ -4,8 +4,18 @@
 coordinates with round-trip precision) and a ``.geo`` that merges it, closes it into a volume
 (``Surface Loop`` + ``Volume``) and sets ``Mesh.CharacteristicLengthMax = size``; then runs
 ``gmsh <name>.geo -3 -nt 1 -format msh22`` and reads the tets back with our own reader
-(:func:`FemBspTet.volume_io.read_tet_mesh`). A discrete surface is not remeshed: Gmsh fills the
-given triangulation, so its boundary is the input's unless its boundary recovery had to split it.
+(:func:`FemBspTet.volume_io.read_tet_mesh`).
+
+Two ways, as TetGen's ``-pY`` and ``-pq``:
+
+* ``remesh_surface=False``: the discrete surface is not remeshed; Gmsh fills the given
+  triangulation (its boundary is the input's unless its boundary recovery had to split it).
+  Gmsh 4.8 then sizes the interior from the surface triangles: ``CharacteristicLengthMax`` has
+  next to no effect (measured: the paper's box with a hole gives 29 tets at 0.5 as at 1.8).
+* ``remesh_surface=True``: ``ClassifySurfaces{40 deg, 1, 1, 180 deg}; CreateGeometry;`` first
+  (Gmsh's own reparametrization of a triangulated surface, as in its tutorial t13), so the
+  surface is remeshed at the size too: new boundary points lie on Gmsh's reparametrized patches,
+  not exactly on the input facets (as TetGen's ``-pq`` points are rounded).
 
 Gmsh writes coordinates with 16 significant digits, which is not always enough to give back the
 exact double: a node whose coordinates, printed the same way, equal those of an input vertex is
@@ -74,10 +84,15 @@ def _write_surface_msh(path, surface: Surface):
         f.write("$EndElements\n")
 
 
-def _write_geo(path, msh_name, size):
+def _write_geo(path, msh_name, size, remesh_surface):
     with open(path, "w") as f:
-        f.write(f'Merge "{msh_name}";\n'
-                "Surface Loop(1) = {1};\n"
+        f.write(f'Merge "{msh_name}";\n')
+        if remesh_surface:
+            f.write("ClassifySurfaces{40 * Pi / 180, 1, 1, Pi};\nCreateGeometry;\n"
+                    "Surface Loop(1) = Surface{:};\n")
+        else:
+            f.write("Surface Loop(1) = {1};\n")
+        f.write(
                 "Volume(1) = {1};\n"
                 "Mesh.SaveAll = 1;\n"
                 f"Mesh.CharacteristicLengthMax = {size!r};\n")
@@ -102,13 +117,15 @@ def restore_input_points(mesh: TetMesh, surface: Surface) -> int:
     return changed
 
 
-def gmsh_command(size):
-    return f"gmsh -3 (CharacteristicLengthMax {size:.4g})"
+def gmsh_command(size, remesh_surface=False):
+    return (f"gmsh -3 ({'surface remeshed, ' if remesh_surface else ''}"
+            f"CharacteristicLengthMax {size:.4g})")
 
 
-def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None,
-             name="surface") -> GmshResult:
-    """Runs Gmsh's 3D mesher on ``surface`` with ``Mesh.CharacteristicLengthMax = size``.
+def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None, name="surface",
+             remesh_surface=False) -> GmshResult:
+    """Runs Gmsh's 3D mesher on ``surface`` with ``Mesh.CharacteristicLengthMax = size``
+    (``remesh_surface``: see the module's doc).
 
     ``keep_dir``: work (and leave the files) there: ``<name>.gmsh_in.msh``, ``<name>.geo``,
     ``<name>.gmsh.msh``. Raises InternalError when Gmsh is missing, fails, makes no tets or
@@ -124,7 +141,7 @@ def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None,
         msh_in = name + ".gmsh_in.msh"
         _write_surface_msh(os.path.join(workdir, msh_in), surface)
         geo = os.path.join(workdir, name + ".geo")
-        _write_geo(geo, msh_in, float(size))
+        _write_geo(geo, msh_in, float(size), remesh_surface)
         out = os.path.join(workdir, name + ".gmsh.msh")
         run = run_measured([exe, geo, "-3", "-nt", "1", "-format", "msh22", "-o", out],
                            timeout=timeout, cwd=workdir)
@@ -138,7 +155,8 @@ def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None,
         if len(mesh.tets) == 0:
             raise InternalError("gmsh made no tetrahedra: " + run.tail())
         restore_input_points(mesh, surface)
-        return GmshResult(mesh=mesh, command=gmsh_command(size), seconds=run.seconds,
+        return GmshResult(mesh=mesh, command=gmsh_command(size, remesh_surface),
+                          seconds=run.seconds,
                           peak_rss_mb=run.peak_rss_mb, output=run.output, mesh_path=out)
     finally:
         if keep_dir is None:
