@@ -256,7 +256,7 @@ def _outcome_summary(entries):
     return f"Outcomes over {len(entries)} models: " + "; ".join(parts) + "."
 
 
-def plot_benchmark(path, entries, cols=5):
+def plot_benchmark(path, entries, cols=6):
     """One small panel per model with every mesher's dihedral-angle histogram."""
     import matplotlib
 
@@ -270,12 +270,12 @@ def plot_benchmark(path, entries, cols=5):
     if not shown:
         return False
     nrows = (len(shown) + cols - 1) // cols
-    fig, axes = plt.subplots(nrows, cols, figsize=(2.6 * cols, 1.9 * nrows), squeeze=False)
+    fig, axes = plt.subplots(nrows, cols, figsize=(2.3 * cols, 1.6 * nrows), squeeze=False)
     for ax, e in zip(axes.ravel(), shown):
         draw_histograms(ax, e.comparison.rows, legend=False)
         ax.set_yscale("log")
         ax.set_title(e.name, fontsize=7)
-        ax.tick_params(labelsize=5)
+        ax.tick_params(which="both", labelsize=5)
     for ax in axes.ravel()[len(shown):]:
         ax.axis("off")
     from matplotlib.lines import Line2D
@@ -290,10 +290,10 @@ def plot_benchmark(path, entries, cols=5):
     handles = [Line2D([], [], color=COLORS.get(m)) for m in seen.values()]
     labels = list(seen)
     fig.legend(handles, labels, loc="upper right", fontsize=7)
-    fig.suptitle("dihedral angles: fraction per degree (log scale), 0-180 deg", fontsize=8)
+    fig.suptitle("dihedral angles, 0-180 deg: fraction per 5 deg (log scale)", fontsize=8)
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     with atomic_output(path, "wb") as f:
-        fig.savefig(f, format="png", dpi=60)
+        fig.savefig(f, format="png", dpi=72)
     plt.close(fig)
     return True
 

@@ -445,14 +445,16 @@ def write_json(path, result: Comparison):
 COLORS = {OURS: "tab:blue", TETGEN_PY: "tab:red", TETGEN_PQ: "tab:orange", GMSH: "tab:green"}
 
 
-def draw_histograms(ax, rows, legend=True):
-    """Dihedral-angle histograms of ``rows`` (fraction of angles per degree) as step lines."""
-    bins = np.arange(181)
+def draw_histograms(ax, rows, legend=True, bin_width=5):
+    """Dihedral-angle histograms of ``rows`` (fraction of angles per ``bin_width`` degrees,
+    summed from the 1-degree bins) as step lines."""
+    edges = np.arange(0, 181, bin_width)
     for r in rows:
         if r.status != "ok" or not r.dihedral_histogram:
             continue
         h = np.asarray(r.dihedral_histogram, float)
-        ax.step(bins[:-1], h / max(h.sum(), 1), where="post", color=COLORS.get(r.mesher),
+        h = np.add.reduceat(h, np.arange(0, 180, bin_width))
+        ax.step(edges[:-1], h / max(h.sum(), 1), where="post", color=COLORS.get(r.mesher),
                 lw=1, label=f"{row_label(r)} (min {r.min_dihedral_deg:.1f})")
     ax.set_xlim(0, 180)
     ax.tick_params(labelsize=7)
