@@ -8,7 +8,8 @@
     fembsptet compare INPUT [--size H] [--json FILE] [--plot FILE.png] [--timeout S] [--keep DIR]
     fembsptet benchmark MODELS_OR_FOLDERS... [--report FILE.md] [--divisions N] [--timeout S]
 
-Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
+``compare`` exits 0 once its table is made, whatever each mesher did (a failing, missing or
+timed-out mesher is a row that says so). Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
 mesh is not valid, and for a run over its memory budget; 1 internal failure (also a crash of the
 native code); 124 time limit reached (--timeout); 130 interrupted (Ctrl-C, SIGTERM).
 ``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.supervisor`): Ctrl-C,
@@ -405,8 +406,9 @@ def build_parser():
                                  "triangles")
     k.add_argument("--size", type=float, default=None,
                    help="element size h: our quality stage at h, tetgen -pq1.414a<h^3/(6 sqrt "
-                        "2)> and gmsh at CharacteristicLengthMax h; without it: our default "
-                        "mesh, tetgen -pY and gmsh at the mean input edge length")
+                        "2)> and gmsh at CharacteristicLengthMax h (gmsh remeshes the surface); "
+                        "without it: our default mesh, tetgen -pY and gmsh filling the surface "
+                        "(at the mean input edge length)")
     k.add_argument("--json", metavar="FILE", default=None, help="write the table as JSON")
     k.add_argument("--plot", metavar="FILE.png", default=None,
                    help="draw the dihedral-angle histograms side by side (matplotlib)")
