@@ -167,6 +167,15 @@ def environment():
                                              if dirty not in ("unknown", "") else ""))]
 
 
+def _short_message(message):
+    """``message`` without the comparison's temporary folder (``/tmp/fembsptet_compare_*/``)."""
+    import re
+    import tempfile
+
+    folder = re.escape(os.path.join(tempfile.gettempdir(), "fembsptet_compare_"))
+    return re.sub(folder + r"[^/\s]*/", "", message)
+
+
 def _cell_text(row, key):
     return row.cell(key) if row.status == "ok" else ""
 
@@ -202,7 +211,7 @@ def report_markdown(entries, command="", png_name=None, env=None):
             continue
         for r in e.comparison.rows:
             if r.status != "ok":
-                msg = r.message.replace("|", "/")[:150]
+                msg = _short_message(r.message).replace("|", "/")[:150]
                 lines.append(f"| {e.name} | {row_label(r)} | **{r.status}**: {msg} |"
                              + " |" * (len(heads) - 3))
                 continue
