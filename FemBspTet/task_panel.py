@@ -98,6 +98,8 @@ class TaskPanelMeshBspTet:
         self.table.setHorizontalHeaderLabels(["FemBspTet", "tetgen -pY"])
         self.table.setVerticalHeaderLabels([headers[k] for k in TABLE_FIELDS])
         self.table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
+        rows_height = sum(self.table.rowHeight(r) for r in range(len(TABLE_FIELDS)))
+        self.table.setMinimumHeight(rows_height + self.table.horizontalHeader().height() + 4)
         res_layout.addWidget(self.stats)
         res_layout.addWidget(self.table)
         layout.addWidget(res)

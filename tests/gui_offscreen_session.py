@@ -123,7 +123,7 @@ try:
         facts["mesh_status"] = obj.MeshStatus
         shot = os.environ.get("FEMBSPTET_GUI_SCREENSHOT")
         if shot:
-            tp.form.resize(420, 760)
+            tp.form.resize(420, 900)
             tp.form.grab().save(shot)
 
     @step("stop keeps the previous mesh")

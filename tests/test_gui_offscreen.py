@@ -94,7 +94,7 @@ def test_task_panel_meshes_in_a_worker_and_shows_stats(facts):
     # the rows and their labels are the comparison's (compare.comparison.COLUMNS)
     assert table["nodes"][0] == str(n) and table["tets"][0] == str(t)
     assert int(table["tets"][1]) == facts["tetgen_tets_property"] > 0
-    assert table["valid"] == ("yes", "yes")
+    assert list(table["valid"]) == ["yes", "yes"]
     assert float(table["min dih"][1]) == pytest.approx(facts["tetgen_min_dihedral_property"],
                                                        abs=0.005)
 
