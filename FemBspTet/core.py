@@ -139,7 +139,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
     refining = any(options.get(k) is not None for k in REFINE_OPTIONS
-                   if k not in ("order", "projection"))
+                   if k not in ("order", "projection", "separate_face_tags"))
+    separating = bool(options.get("separate_face_tags"))
     native = _native()
     checked, flipped = [], 0
     for surface in surfaces:
@@ -178,10 +179,11 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             raise InternalError(
                 f"{surface.source or 'surface'}: the mesh failed its own exact check ("
                 + "; ".join(report_check["messages"]) + "); this is a bug, please report it")
-        if refining or order == 2:
+        if refining or order == 2 or (separating and surface.face_tags is not None):
             refine_options = {k: v for k, v in options.items() if k in REFINE_OPTIONS}
             if not refining:
-                refine_options = {"order": 2, "projection": options.get("projection")}
+                refine_options = {"order": order, "projection": options.get("projection"),
+                                  "separate_face_tags": separating}
             mesh, refine_stats = refine(surface, mesh, refine_options, progress=report,
                                         cancel=cancel)
             st["refine"] = refine_stats
@@ -213,6 +215,12 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
                 "on those facets or edges near the midpoint, so elements there stay larger than the "
                 "size (surface_points='rounded' / --surface-points rounded refines them, with the "
                 "boundary then within rounding of the input)")
+        if r.get("tag_conflicts_left"):
+            notes.append(
+                f"{r['tag_conflicts_left']} tets still have four corners on one CAD face (or three "
+                "that are not their face there): FreeCAD's CalculiX writer, which finds element "
+                "faces by their nodes, may load those faces wrongly; a smaller size usually "
+                "removes them")
         if r.get("midnodes_straightened"):
             notes.append(f"{r['midnodes_straightened']} curved mid-nodes were put back on their chord "
                          "(the curved tet would not have been valid)")
@@ -290,6 +298,9 @@ REFINE_OPTIONS = {
     "projection": "callable (point (3,), tag, other_tag) -> point moving new surface points onto "
                   "the true surface (other_tag is -1 except on an edge between two face tags)",
     "order": "1 or 2 (10-node tets; boundary mid-nodes through projection)",
+    "separate_face_tags": "True: no tet has four corners on one face tag, and three only as its "
+                          "boundary face there, so that FEM tools that find element faces by node "
+                          "membership (FreeCAD's CalculiX writer) load exactly the boundary faces",
 }
 
 #: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
@@ -347,7 +358,8 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     projection = options.get("projection")
     if projection is not None and not callable(projection):
         raise InputError("projection must be a callable (point, tag, other_tag) -> point")
-    only_order = set(k for k, v in options.items() if v is not None) <= {"order", "projection"}
+    only_order = (set(k for k, v in options.items() if v is not None)
+                  <= {"order", "projection", "separate_face_tags"})
     native = _native()
     try:
         points, tets, st = native.refine(
@@ -355,12 +367,14 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
             min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
             projection=projection, max_passes=0 if only_order else 40,
-            optimize_rounds=0 if only_order else 8, progress=progress, cancel=cancel)
+            optimize_rounds=0 if only_order else 8,
+            separate_face_tags=bool(options.get("separate_face_tags")), progress=progress,
+            cancel=cancel)
     except native.InputError as exc:
         raise InputError(str(exc)) from None
     except native.MeshingError as exc:
         if getattr(exc, "code", "") == "cancelled":
-            raise InternalError("cancelled: no mesh was made") from None
+            raise Cancelled("cancelled: no mesh was made") from None
         raise InternalError(
             f"{surface.source or 'surface'}: the refinement failed ({exc}); this is a bug, "
             "please report it with the input") from None

@@ -21,6 +21,7 @@
 //     raise the smallest dihedral angle locally, tets with a radius-edge ratio above the bound get
 //     their shortest edge collapsed or their longest edge split. Rounds stop when nothing changes
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
+//  2b. separate_face_tags (optional): see the option;
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
 // Deterministic: edges and tets are visited in sorted order; no randomness.
 #pragma once
@@ -59,6 +60,14 @@ struct RefineOptions {
   /// The optimization stops when the smallest dihedral angle reaches this (degrees; 0: it runs
   /// until no operation helps or optimize_rounds).
   double min_dihedral_deg = 0;
+  /// Make the mesh readable by FEM pre-processors that find the element faces on a CAD face by
+  /// node membership alone (FreeCAD's getccxVolumesByFace and its CalculiX writer: a tet counts
+  /// as having a face on face tag T when exactly three of its corners lie on T). After this step
+  /// no tet has four corners on one tag's boundary triangles, and a tet with three corners on tag
+  /// T has them as one of its boundary faces of tag T. Done by splitting, per offending tet, an
+  /// edge between two such corners that is not an edge of a boundary face of tag T (an interior
+  /// edge, or an edge of another tag's face: the new point lies off T). Only with face tags.
+  bool separate_face_tags = false;
   /// 1: linear tets; 2: 10-node tets (tet10.h).
   int order = 1;
   int max_passes = 40;       ///< size passes at most
@@ -85,6 +94,8 @@ struct RefineStats {
   std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
   std::int64_t size_passes = 0, optimize_rounds = 0;
   std::int64_t long_edges_left = 0;      ///< edges still longer than split_ratio * target
+  std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split
+  std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
   double seconds = 0;
 };
