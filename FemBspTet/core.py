@@ -13,10 +13,39 @@
 conditions are listed in ``cpp_module/include/bsptet/mesh_check.h``.
 """
 
+import contextlib
+
 import numpy as np
 
 from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
 from .mesh_types import Surface, TetMesh
+
+
+@contextlib.contextmanager
+def _core_errors(surface, stage):
+    """The core's errors as the package's: InputError (naming the input), Cancelled, and
+    InternalError for anything else (a bug of ours: the message asks for a report)."""
+    native = _native()
+    try:
+        yield
+    except native.InputError as exc:
+        raise InputError(str(exc), where=surface.source or None) from None
+    except native.MeshingError as exc:
+        if getattr(exc, "code", "") == "cancelled":
+            raise Cancelled("cancelled: no mesh was made") from None
+        raise InternalError(
+            f"{surface.source or 'surface'}: the {stage} failed ({exc}); this is a bug, "
+            "please report it with the input") from None
+
+
+def _checked(reference, mesh, what, source=None):
+    """The exact check of ``mesh`` against ``reference``; InternalError if it fails."""
+    report = check_mesh(reference, mesh, max_messages=5)
+    if not report["valid"]:
+        raise InternalError(
+            f"{source or reference.source or 'surface'}: the {what} failed its own exact check ("
+            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    return report
 
 
 def _native():
@@ -160,25 +189,13 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             if progress is not None:
                 progress(label + stage, fraction)
 
-        try:
+        with _core_errors(surface, "mesher"):
             points, tets, st = native.tetrahedralize(
                 surface.points, surface.triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
                 progress=report, cancel=cancel)
-        except native.InputError as exc:
-            raise InputError(str(exc), where=surface.source or None) from None
-        except native.MeshingError as exc:
-            if getattr(exc, "code", "") == "cancelled":
-                raise Cancelled("cancelled: no mesh was made") from None
-            raise InternalError(
-                f"{surface.source or 'surface'}: the mesher failed ({exc}); this is a bug, "
-                "please report it with the input") from None
         mesh = TetMesh(points, tets, surface.source)
-        report_check = check_mesh(surface, mesh, max_messages=5)
-        if not report_check["valid"]:
-            raise InternalError(
-                f"{surface.source or 'surface'}: the mesh failed its own exact check ("
-                + "; ".join(report_check["messages"]) + "); this is a bug, please report it")
+        report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):
             refine_options = {k: v for k, v in options.items() if k in REFINE_OPTIONS}
             if not refining:
@@ -361,7 +378,7 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     only_order = (set(k for k, v in options.items() if v is not None)
                   <= {"order", "projection", "separate_face_tags"})
     native = _native()
-    try:
+    with _core_errors(surface, "refinement"):
         points, tets, st = native.refine(
             surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
@@ -370,22 +387,10 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             optimize_rounds=0 if only_order else 8,
             separate_face_tags=bool(options.get("separate_face_tags")), progress=progress,
             cancel=cancel)
-    except native.InputError as exc:
-        raise InputError(str(exc)) from None
-    except native.MeshingError as exc:
-        if getattr(exc, "code", "") == "cancelled":
-            raise Cancelled("cancelled: no mesh was made") from None
-        raise InternalError(
-            f"{surface.source or 'surface'}: the refinement failed ({exc}); this is a bug, "
-            "please report it with the input") from None
     out = TetMesh(points, tets, mesh.source)
     exact = mode == "exact" and projection is None
     reference = surface if exact else boundary_surface(out)
-    report = check_mesh(reference, out, max_messages=5)
-    if not report["valid"]:
-        raise InternalError(
-            f"{surface.source or 'surface'}: the refined mesh failed its own exact check ("
-            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    report = _checked(reference, out, "refined mesh", source=surface.source)
     st["checked_against"] = "input surface" if exact else "own boundary"
     on_boundary = len(np.unique(boundary_surface(out).triangles))
     st["steiner_points"] = int(st["points"] - len(surface.points))
