@@ -28,6 +28,10 @@ void check_options(const RefineOptions& o) {
     if (!(s > 0) || !std::isfinite(s))
       bad("the size of face tag " + std::to_string(tag) + " must be a positive length, got " + std::to_string(s));
   if (!(o.grading > 0)) bad("grading must be positive, got " + std::to_string(o.grading));
+  if (!(o.collapse_ratio >= 0 && o.collapse_ratio < o.split_ratio))
+    bad("collapse_ratio must be in [0, split_ratio), got " + std::to_string(o.collapse_ratio));
+  if (!(o.collapse_min_dihedral_deg >= 0 && o.collapse_min_dihedral_deg <= 180))
+    bad("collapse_min_dihedral_deg must be in [0, 180], got " + std::to_string(o.collapse_min_dihedral_deg));
   if (!(o.split_ratio >= 1) || !std::isfinite(o.split_ratio))
     bad("split_ratio must be at least 1, got " + std::to_string(o.split_ratio));
   if (!(o.radius_edge_bound == 0 || o.radius_edge_bound >= 0.7))
@@ -382,7 +386,7 @@ class Refiner {
       for (const auto& [from, to] : {std::pair<Index, Index>{u, v}, std::pair<Index, Index>{v, u}}) {
         if (m_.support(from).kind == Support::kInputVertex) continue;
         const double lim = o_.split_ratio * target(to);
-        if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf)) {
+        if (m_.collapse_edge(from, to, o_.collapse_min_dihedral_deg, std::isfinite(lim) ? lim * lim : kInf)) {
           ++n;
           break;
         }
@@ -514,7 +518,8 @@ class Refiner {
       bool done = false;
       for (const auto& [from, to] : {std::pair<Index, Index>{a, b}, std::pair<Index, Index>{b, a}}) {
         if (m_.support(from).kind == Support::kInputVertex) continue;
-        if (m_.collapse_edge(from, to, 180.0, kInf)) {
+        const double lim = o_.split_ratio * target(to);
+        if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf)) {
           ++st_.collapses;
           done = true;
           break;
