@@ -305,7 +305,7 @@ def signed_volume(surface: Surface) -> float:
 
 #: Options of the quality stage (cpp_module/include/bsptet/quality_refine.h), with their meaning.
 REFINE_OPTIONS = {
-    "size": "target edge length h (model units; edges longer than about 1.4 h are split)",
+    "size": "target edge length h (model units; edges longer than 2 h are split, as FreeCAD's CharacteristicLengthMax for Gmsh)",
     "min_size": "edges shorter than 2 min_size are never split (default: smallest size / 8)",
     "size_by_tag": "{face tag: size} near the input triangles of that tag (a CAD face)",
     "radius_edge": "refine tets whose circumradius / shortest edge exceeds this (0 or None: off)",
