@@ -356,8 +356,8 @@ def build_parser():
     m.add_argument("-o", "--output", action="append", required=True,
                    help="output mesh; repeat for several (.vtu .msh .inp .node .mesh .unv .med .z88)")
     m.add_argument("--size", type=float, default=None,
-                   help="element size h (target edge length; edges longer than about 1.4 h are "
-                        "split); also the CAD tessellation size")
+                   help="element size h (target edge length; edges longer than 2 h are split, as "
+                        "Gmsh's CharacteristicLengthMax); also the CAD tessellation size")
     m.add_argument("--min-size", type=float, default=None,
                    help="edges shorter than twice this are never split (default: size / 8)")
     m.add_argument("--radius-edge", type=float, default=None,

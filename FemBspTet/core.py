@@ -13,10 +13,39 @@
 conditions are listed in ``cpp_module/include/bsptet/mesh_check.h``.
 """
 
+import contextlib
+
 import numpy as np
 
 from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
 from .mesh_types import Surface, TetMesh
+
+
+@contextlib.contextmanager
+def _core_errors(surface, stage):
+    """The core's errors as the package's: InputError (naming the input), Cancelled, and
+    InternalError for anything else (a bug of ours: the message asks for a report)."""
+    native = _native()
+    try:
+        yield
+    except native.InputError as exc:
+        raise InputError(str(exc), where=surface.source or None) from None
+    except native.MeshingError as exc:
+        if getattr(exc, "code", "") == "cancelled":
+            raise Cancelled("cancelled: no mesh was made") from None
+        raise InternalError(
+            f"{surface.source or 'surface'}: the {stage} failed ({exc}); this is a bug, "
+            "please report it with the input") from None
+
+
+def _checked(reference, mesh, what, source=None):
+    """The exact check of ``mesh`` against ``reference``; InternalError if it fails."""
+    report = check_mesh(reference, mesh, max_messages=5)
+    if not report["valid"]:
+        raise InternalError(
+            f"{source or reference.source or 'surface'}: the {what} failed its own exact check ("
+            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    return report
 
 
 def _native():
@@ -139,7 +168,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
     refining = any(options.get(k) is not None for k in REFINE_OPTIONS
-                   if k not in ("order", "projection"))
+                   if k not in ("order", "projection", "separate_face_tags"))
+    separating = bool(options.get("separate_face_tags"))
     native = _native()
     checked, flipped = [], 0
     for surface in surfaces:
@@ -159,29 +189,18 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             if progress is not None:
                 progress(label + stage, fraction)
 
-        try:
+        with _core_errors(surface, "mesher"):
             points, tets, st = native.tetrahedralize(
                 surface.points, surface.triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
                 progress=report, cancel=cancel)
-        except native.InputError as exc:
-            raise InputError(str(exc), where=surface.source or None) from None
-        except native.MeshingError as exc:
-            if getattr(exc, "code", "") == "cancelled":
-                raise Cancelled("cancelled: no mesh was made") from None
-            raise InternalError(
-                f"{surface.source or 'surface'}: the mesher failed ({exc}); this is a bug, "
-                "please report it with the input") from None
         mesh = TetMesh(points, tets, surface.source)
-        report_check = check_mesh(surface, mesh, max_messages=5)
-        if not report_check["valid"]:
-            raise InternalError(
-                f"{surface.source or 'surface'}: the mesh failed its own exact check ("
-                + "; ".join(report_check["messages"]) + "); this is a bug, please report it")
-        if refining or order == 2:
+        report_check = _checked(surface, mesh, "mesh")
+        if refining or order == 2 or (separating and surface.face_tags is not None):
             refine_options = {k: v for k, v in options.items() if k in REFINE_OPTIONS}
             if not refining:
-                refine_options = {"order": 2, "projection": options.get("projection")}
+                refine_options = {"order": order, "projection": options.get("projection"),
+                                  "separate_face_tags": separating}
             mesh, refine_stats = refine(surface, mesh, refine_options, progress=report,
                                         cancel=cancel)
             st["refine"] = refine_stats
@@ -213,6 +232,12 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
                 "on those facets or edges near the midpoint, so elements there stay larger than the "
                 "size (surface_points='rounded' / --surface-points rounded refines them, with the "
                 "boundary then within rounding of the input)")
+        if r.get("tag_conflicts_left"):
+            notes.append(
+                f"{r['tag_conflicts_left']} tets still have four corners on one CAD face (or three "
+                "that are not their face there): FreeCAD's CalculiX writer, which finds element "
+                "faces by their nodes, may load those faces wrongly; a smaller size usually "
+                "removes them")
         if r.get("midnodes_straightened"):
             notes.append(f"{r['midnodes_straightened']} curved mid-nodes were put back on their chord "
                          "(the curved tet would not have been valid)")
@@ -280,7 +305,7 @@ def signed_volume(surface: Surface) -> float:
 
 #: Options of the quality stage (cpp_module/include/bsptet/quality_refine.h), with their meaning.
 REFINE_OPTIONS = {
-    "size": "target edge length h (model units; edges longer than about 1.4 h are split)",
+    "size": "target edge length h (model units; edges longer than 2 h are split, as FreeCAD's CharacteristicLengthMax for Gmsh)",
     "min_size": "edges shorter than 2 min_size are never split (default: smallest size / 8)",
     "size_by_tag": "{face tag: size} near the input triangles of that tag (a CAD face)",
     "radius_edge": "refine tets whose circumradius / shortest edge exceeds this (0 or None: off)",
@@ -290,6 +315,9 @@ REFINE_OPTIONS = {
     "projection": "callable (point (3,), tag, other_tag) -> point moving new surface points onto "
                   "the true surface (other_tag is -1 except on an edge between two face tags)",
     "order": "1 or 2 (10-node tets; boundary mid-nodes through projection)",
+    "separate_face_tags": "True: no tet has four corners on one face tag, and three only as its "
+                          "boundary face there, so that FEM tools that find element faces by node "
+                          "membership (FreeCAD's CalculiX writer) load exactly the boundary faces",
 }
 
 #: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
@@ -347,31 +375,22 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     projection = options.get("projection")
     if projection is not None and not callable(projection):
         raise InputError("projection must be a callable (point, tag, other_tag) -> point")
-    only_order = set(k for k, v in options.items() if v is not None) <= {"order", "projection"}
+    only_order = (set(k for k, v in options.items() if v is not None)
+                  <= {"order", "projection", "separate_face_tags"})
     native = _native()
-    try:
+    with _core_errors(surface, "refinement"):
         points, tets, st = native.refine(
             surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
             min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
             projection=projection, max_passes=0 if only_order else 40,
-            optimize_rounds=0 if only_order else 8, progress=progress, cancel=cancel)
-    except native.InputError as exc:
-        raise InputError(str(exc)) from None
-    except native.MeshingError as exc:
-        if getattr(exc, "code", "") == "cancelled":
-            raise InternalError("cancelled: no mesh was made") from None
-        raise InternalError(
-            f"{surface.source or 'surface'}: the refinement failed ({exc}); this is a bug, "
-            "please report it with the input") from None
+            optimize_rounds=0 if only_order else 8,
+            separate_face_tags=bool(options.get("separate_face_tags")), progress=progress,
+            cancel=cancel)
     out = TetMesh(points, tets, mesh.source)
     exact = mode == "exact" and projection is None
     reference = surface if exact else boundary_surface(out)
-    report = check_mesh(reference, out, max_messages=5)
-    if not report["valid"]:
-        raise InternalError(
-            f"{surface.source or 'surface'}: the refined mesh failed its own exact check ("
-            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    report = _checked(reference, out, "refined mesh", source=surface.source)
     st["checked_against"] = "input surface" if exact else "own boundary"
     on_boundary = len(np.unique(boundary_surface(out).triangles))
     st["steiner_points"] = int(st["points"] - len(surface.points))

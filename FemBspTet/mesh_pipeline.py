@@ -231,8 +231,11 @@ def _json_default(value):
 def core_options(params, projection=None):
     """The ``options`` dict for ``core.tetrahedralize`` from ``params`` (zero, i.e. automatic
     or off, values are left out; the names are in ``core.OPTION_NAMES``)."""
+    # FreeCAD finds the element faces under a constraint by node membership (freecad.md §7):
+    # the mesh must not let a tet look as if it had a face on a CAD face it does not have.
     opts = {CORE_OPTION_OF["order"]: int(params.order),
-            CORE_OPTION_OF["allow_boundary_steiner"]: bool(params.allow_boundary_steiner)}
+            CORE_OPTION_OF["allow_boundary_steiner"]: bool(params.allow_boundary_steiner),
+            "separate_face_tags": True}
     for field in ("max_size", "min_size", "quality_bound"):
         value = getattr(params, field)
         if value > 0:

@@ -80,19 +80,21 @@ def test_acceptance_cantilever_within_1_percent_of_gmsh(cantilever_ours, cantile
     assert abs(ours / gmsh - 1) <= 0.01, (ours, gmsh)
 
 
-def test_plate_hole_face_nodes_found_and_pressure_solves(freecad, tmp_path_factory):
-    """tet4 (what works on curved faces today): every boundary node of the hole's face is found
-    by getNodesByFace, CalculiX's face search finds exactly our boundary triangles there, and
-    the pressure case solves."""
+@pytest.mark.parametrize("order", [1, 2])
+def test_plate_hole_face_nodes_found_and_pressure_solves(freecad, tmp_path_factory, order):
+    """tet4 and tet10: every boundary node of the hole's face (mid-nodes included) is found by
+    getNodesByFace, CalculiX's face search finds exactly our boundary triangles there, and the
+    pressure case solves."""
     from FemBspTet import mesh_pipeline, mesher_tools
 
     doc = freecad.newDocument("PlateNodes")
     try:
         case = cc.build_case(doc, "plate_with_hole")
-        obj = cc.add_bsptet_mesh(case, cc.CASES["plate_with_hole"]["size"], 1)
+        obj = cc.add_bsptet_mesh(case, cc.CASES["plate_with_hole"]["size"], order)
         shape = case.part.Shape
         k = int(case.loaded_face[len("Face"):]) - 1
         result = mesh_pipeline.mesh_cad_shape(shape, mesher_tools.parameters_from_object(obj))
+        assert result.mesh.tets.shape[1] == (4 if order == 1 else 10)
         face = shape.Faces[k]
         want = set((result.face_nodes(k) + 1).tolist())
         found = set(obj.FemMesh.getNodesByFace(face))

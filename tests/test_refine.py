@@ -74,14 +74,17 @@ def test_exact_refinement_of_paper_models_tiles_the_input(name):
     assert sum(stats["dihedral_histogram"]) == 6 * len(mesh.tets)
 
 
-def test_cube_reaches_the_size_and_keeps_every_dihedral_above_40_degrees():
+def test_cube_reaches_the_size_and_keeps_every_dihedral_above_25_degrees():
     surface = read_surface(corpus_path("cube"))  # integer corners: every midpoint is exact
     h = diag(surface) / 10
     mesh, stats = core.tetrahedralize(surface, options={"size": h})
     assert core.check_mesh(surface, mesh)["valid"]
-    assert edge_lengths(mesh).max() <= 1.4 * h
-    assert stats["refine"]["long_edges_left"] == 0
-    assert stats["min_dihedral_deg"] > 40
+    # split_ratio 2 (quality_refine.h); flips and smoothing after the last split pass may leave
+    # a few edges longer, and the stage counts them
+    lengths = edge_lengths(mesh)
+    assert (lengths > 2.0 * h * (1 + 1e-9)).sum() <= stats["refine"]["long_edges_left"] <= 4
+    assert lengths.max() <= 2.2 * h
+    assert stats["min_dihedral_deg"] > 25
     # halving the size multiplies the tets by about 8
     finer, _ = core.tetrahedralize(surface, options={"size": h / 2})
     assert 5 < len(finer.tets) / len(mesh.tets) < 11
@@ -143,7 +146,7 @@ def test_projection_hook_puts_every_boundary_node_on_a_sphere():
     assert report["valid"], report["messages"]
     assert report["inconsistent_midnodes"] == 0
     nodes = boundary_nodes(mesh)
-    assert len(nodes) > 4 * len(surface.points)  # refined: many new surface points and mid-nodes
+    assert len(nodes) > 3 * len(surface.points)  # refined: many new surface points and mid-nodes
     assert sphere_distance(mesh.points[nodes], radius).max() <= 1e-9
     assert stats["refine"]["midnodes_straightened"] == 0
     # interior nodes are strictly inside
@@ -172,7 +175,8 @@ def test_projection_hook_puts_every_boundary_node_on_a_cylinder():
 
 def test_cantilever_box_end_faces_are_exact():
     """freecad.md section 6: 8000 x 1000 x 1000 at h = 500. End-face nodes lie exactly on x = 0
-    and x = 8000 (tet10 mid-nodes included). Our tet count there is ~4x Gmsh's 400 (README)."""
+    and x = 8000 (tet10 mid-nodes included); the tet count is within 30% of FreeCAD's Gmsh mesh
+    at CharacteristicLengthMax = 500 (400 tets)."""
     surface = box_surface(8000.0, 1000.0, 1000.0)
     mesh, stats = core.tetrahedralize(surface, options={"size": 500.0, "order": 2})
     report = core.check_mesh(surface, mesh)  # tet10: the linear part tiles the input exactly
@@ -181,17 +185,15 @@ def test_cantilever_box_end_faces_are_exact():
     pts = mesh.points
     for end in (0.0, 8000.0):
         faces = b.triangles[np.isclose(pts[b.triangles][:, :, 0], end, atol=1e-6).all(axis=1)]
-        assert len(faces) >= 8
+        assert len(faces) > 2  # refined beyond the input's two triangles
         assert (pts[np.unique(faces)][:, 0] == end).all()
     nodes = boundary_nodes(mesh)
     near_end = nodes[np.isclose(pts[nodes, 0], 0.0, atol=1e-6) | np.isclose(pts[nodes, 0], 8000.0,
                                                                              atol=1e-6)]
     assert set(np.unique(pts[near_end, 0]).tolist()) == {0.0, 8000.0}
-    regular = 500.0 ** 3 / (6 * 2 ** 0.5)
-    assert 0.5 * 8e9 / regular < stats["tets"] < 4 * 8e9 / regular
-    # smoothing after the last split pass may stretch a few edges a little past 1.4 h
+    assert 0.7 * 400 <= stats["tets"] <= 1.3 * 400
     lengths = edge_lengths(mesh)
-    assert lengths.max() <= 1.6 * 500.0 and (lengths > 1.4 * 500.0).mean() < 0.01
+    assert (lengths > 2.0 * 500.0 * (1 + 1e-9)).sum() <= stats["refine"]["long_edges_left"]
 
 
 def test_size_by_tag_refines_near_one_face():

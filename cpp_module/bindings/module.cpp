@@ -72,6 +72,41 @@ TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
   return m;
 }
 
+// Runs `run` (a call of the core) without the GIL, with the options' `cancelled` and `progress`
+// callbacks wired to Python (they take the GIL for each call). Ctrl-C (a pending SIGINT) cancels
+// the run and raises KeyboardInterrupt; `cancel()` returning True cancels it with the core's
+// MeshingError (code "cancelled"). Options: MeshOptions or RefineOptions.
+template <class Options, class Run>
+void run_without_gil(Options& o, const py::object& progress, const py::object& cancel, Run&& run) {
+  bool interrupted = false;
+  o.cancelled = [&]() {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();
+      interrupted = true;
+      return true;
+    }
+    return !cancel.is_none() && cancel().cast<bool>();
+  };
+  if (!progress.is_none())
+    o.progress = [&](const std::string& stage, double f) {
+      py::gil_scoped_acquire gil;
+      progress(stage, f);
+    };
+  try {
+    py::gil_scoped_release release;
+    run();
+  } catch (const MeshingError& e) {
+    if (e.code() == ErrorCode::kCancelled && interrupted) {
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+      throw py::error_already_set();
+    }
+    throw;
+  }
+  o.cancelled = nullptr;
+  o.progress = nullptr;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_bsptet, m) {
@@ -105,35 +140,9 @@ PYBIND11_MODULE(_bsptet, m) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
-        bool interrupted = false;
-        // Callbacks run without the GIL held by the core: take it for each call. Ctrl-C (a pending
-        // SIGINT) cancels the run; so does `cancel()` returning True.
-        o.cancelled = [&]() {
-          py::gil_scoped_acquire gil;
-          if (PyErr_CheckSignals() != 0) {
-            PyErr_Clear();
-            interrupted = true;
-            return true;
-          }
-          return !cancel.is_none() && cancel().cast<bool>();
-        };
-        if (!progress.is_none())
-          o.progress = [&](const std::string& stage, double f) {
-            py::gil_scoped_acquire gil;
-            progress(stage, f);
-          };
         TetMesh mesh;
         MeshStats st;
-        try {
-          py::gil_scoped_release release;
-          mesh = tetrahedralize(s, o, &st);
-        } catch (const MeshingError& e) {
-          if (e.code() == ErrorCode::kCancelled && interrupted) {
-            PyErr_SetNone(PyExc_KeyboardInterrupt);
-            throw py::error_already_set();
-          }
-          throw;
-        }
+        run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
         py::array_t<double> xyz({static_cast<py::ssize_t>(mesh.num_points()), static_cast<py::ssize_t>(3)});
         std::copy(mesh.xyz.begin(), mesh.xyz.end(), xyz.mutable_data());
         py::array_t<std::int64_t> tets({static_cast<py::ssize_t>(mesh.num_tets()), static_cast<py::ssize_t>(4)});
@@ -214,7 +223,7 @@ PYBIND11_MODULE(_bsptet, m) {
          const DoubleArray& points, const IndexArray& tets, double size, double min_size,
          std::map<std::int32_t, double> size_by_tag, double radius_edge, double min_dihedral, int order,
          const std::string& surface_points_mode, py::object projection, int max_passes, int optimize_rounds,
-         py::object progress, py::object cancel) {
+         bool separate_face_tags, py::object progress, py::object cancel) {
         SurfaceMesh s;
         s.xyz = points_from(surface_points, "surface_points");
         s.tri = indices_from(surface_triangles, "surface_triangles", 3);
@@ -234,6 +243,7 @@ PYBIND11_MODULE(_bsptet, m) {
         o.order = order;
         o.max_passes = max_passes;
         o.optimize_rounds = optimize_rounds;
+        o.separate_face_tags = separate_face_tags;
         if (surface_points_mode == "exact") o.surface_points = SurfacePoints::kExact;
         else if (surface_points_mode == "rounded") o.surface_points = SurfacePoints::kRounded;
         else throw py::value_error("surface_points must be 'exact' or 'rounded', got '" + surface_points_mode + "'");
@@ -247,33 +257,9 @@ PYBIND11_MODULE(_bsptet, m) {
             const auto r = projection(a, tag, other).cast<std::array<double, 3>>();
             return Vec3{r[0], r[1], r[2]};
           };
-        bool interrupted = false;
-        o.cancelled = [&]() {
-          py::gil_scoped_acquire gil;
-          if (PyErr_CheckSignals() != 0) {
-            PyErr_Clear();
-            interrupted = true;
-            return true;
-          }
-          return !cancel.is_none() && cancel().cast<bool>();
-        };
-        if (!progress.is_none())
-          o.progress = [&](const std::string& stage, double f) {
-            py::gil_scoped_acquire gil;
-            progress(stage, f);
-          };
         TetMesh out;
         RefineStats st;
-        try {
-          py::gil_scoped_release release;
-          out = refine_quality(s, mesh, o, &st);
-        } catch (const MeshingError& e) {
-          if (e.code() == ErrorCode::kCancelled && interrupted) {
-            PyErr_SetNone(PyExc_KeyboardInterrupt);
-            throw py::error_already_set();
-          }
-          throw;
-        }
+        run_without_gil(o, progress, cancel, [&]() { out = refine_quality(s, mesh, o, &st); });
         const py::ssize_t npt = out.nodes_per_tet;
         py::array_t<double> xyz({static_cast<py::ssize_t>(out.num_points()), static_cast<py::ssize_t>(3)});
         std::copy(out.xyz.begin(), out.xyz.end(), xyz.mutable_data());
@@ -295,6 +281,8 @@ PYBIND11_MODULE(_bsptet, m) {
         d["size_passes"] = st.size_passes;
         d["optimize_rounds"] = st.optimize_rounds;
         d["long_edges_left"] = st.long_edges_left;
+        d["tag_splits"] = st.tag_splits;
+        d["tag_conflicts_left"] = st.tag_conflicts_left;
         d["midnodes_projected"] = st.midnodes_projected;
         d["midnodes_straightened"] = st.midnodes_straightened;
         d["seconds"] = st.seconds;
@@ -305,7 +293,7 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("size_by_tag") = std::map<std::int32_t, double>{}, py::arg("radius_edge") = 0.0,
       py::arg("min_dihedral") = 0.0, py::arg("order") = 1, py::arg("surface_points_mode") = "exact",
       py::arg("projection") = py::none(), py::arg("max_passes") = 40, py::arg("optimize_rounds") = 8,
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      py::arg("separate_face_tags") = false, py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       "Refines a valid tet mesh of a closed surface to a size and quality (see quality_refine.h). "
       "projection(point (3,), tag, other_tag) -> point moves new surface points. Returns (points, tets "
       "(m, 4) or (m, 10), stats dict).");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <queue>
 #include <string>
 #include <tuple>
@@ -27,6 +28,10 @@ void check_options(const RefineOptions& o) {
     if (!(s > 0) || !std::isfinite(s))
       bad("the size of face tag " + std::to_string(tag) + " must be a positive length, got " + std::to_string(s));
   if (!(o.grading > 0)) bad("grading must be positive, got " + std::to_string(o.grading));
+  if (!(o.collapse_ratio >= 0 && o.collapse_ratio < o.split_ratio))
+    bad("collapse_ratio must be in [0, split_ratio), got " + std::to_string(o.collapse_ratio));
+  if (!(o.collapse_min_dihedral_deg >= 0 && o.collapse_min_dihedral_deg <= 180))
+    bad("collapse_min_dihedral_deg must be in [0, 180], got " + std::to_string(o.collapse_min_dihedral_deg));
   if (!(o.split_ratio >= 1) || !std::isfinite(o.split_ratio))
     bad("split_ratio must be at least 1, got " + std::to_string(o.split_ratio));
   if (!(o.radius_edge_bound == 0 || o.radius_edge_bound >= 0.7))
@@ -54,6 +59,7 @@ class Refiner {
     compute_targets();
     for (const auto& e : m_.edges())
       if (is_long(e[0], e[1])) ++st_.long_edges_left;
+    if (o_.separate_face_tags && !m_.surface().tag.empty()) separate_face_tags();
   }
 
  private:
@@ -236,6 +242,87 @@ class Refiner {
     }
   }
 
+  // ---- separate_face_tags (see the option) ---------------------------------------------------
+  // The offending tets (see the option), each with the edges whose split would mend it, best
+  // first: interior edges (their midpoint is off every face), then edges of other tags' faces;
+  // longer first.
+  std::vector<std::vector<std::array<Index, 2>>> tag_conflicts() {
+    using Key3 = std::array<Index, 3>;
+    std::map<Key3, std::int32_t> face_tag;                                // sorted boundary face -> tag
+    std::map<std::array<Index, 2>, std::vector<std::int32_t>> edge_tags;  // boundary edge -> tags
+    std::vector<std::vector<std::int32_t>> point_tags(static_cast<std::size_t>(m_.num_points()));
+    for (const auto& [face, parent] : m_.boundary_faces()) {
+      const std::int32_t tag = m_.tag_of(parent);
+      Key3 key = face;
+      std::sort(key.begin(), key.end());
+      face_tag[key] = tag;
+      for (int i = 0; i < 3; ++i) {
+        auto& pt = point_tags[static_cast<std::size_t>(face[i])];
+        if (std::find(pt.begin(), pt.end(), tag) == pt.end()) pt.push_back(tag);
+        std::array<Index, 2> e{std::min(face[i], face[(i + 1) % 3]), std::max(face[i], face[(i + 1) % 3])};
+        auto& et = edge_tags[e];
+        if (std::find(et.begin(), et.end(), tag) == et.end()) et.push_back(tag);
+      }
+    }
+    auto on_tag = [&](Index v, std::int32_t tag) {
+      const auto& pt = point_tags[static_cast<std::size_t>(v)];
+      return std::find(pt.begin(), pt.end(), tag) != pt.end();
+    };
+    std::vector<std::vector<std::array<Index, 2>>> out;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t) {
+      if (!m_.tet_alive(t)) continue;
+      const auto q = m_.tet(t);
+      std::vector<std::int32_t> tags;
+      for (Index v : q)
+        for (std::int32_t tag : point_tags[static_cast<std::size_t>(v)])
+          if (std::find(tags.begin(), tags.end(), tag) == tags.end()) tags.push_back(tag);
+      std::sort(tags.begin(), tags.end());
+      for (std::int32_t tag : tags) {
+        std::vector<Index> on;
+        for (Index v : q)
+          if (on_tag(v, tag)) on.push_back(v);
+        if (on.size() < 3) continue;
+        if (on.size() == 3) {
+          Key3 key{on[0], on[1], on[2]};
+          std::sort(key.begin(), key.end());
+          const auto it = face_tag.find(key);
+          if (it != face_tag.end() && it->second == tag) continue;
+        }
+        std::vector<std::tuple<bool, double, Index, Index>> ranked;
+        for (std::size_t i = 0; i < on.size(); ++i)
+          for (std::size_t j = i + 1; j < on.size(); ++j) {
+            const Index a = std::min(on[i], on[j]), b = std::max(on[i], on[j]);
+            const auto it = edge_tags.find({a, b});
+            const bool boundary = it != edge_tags.end();
+            if (boundary && std::find(it->second.begin(), it->second.end(), tag) != it->second.end()) continue;
+            ranked.emplace_back(boundary, -length(a, b), a, b);
+          }
+        std::sort(ranked.begin(), ranked.end());
+        std::vector<std::array<Index, 2>> edges;
+        for (const auto& r : ranked) edges.push_back({std::get<2>(r), std::get<3>(r)});
+        out.push_back(std::move(edges));
+        break;
+      }
+    }
+    return out;
+  }
+
+  void separate_face_tags() {
+    for (int pass = 0; pass < 16; ++pass) {
+      poll("separating CAD faces", 0.9);
+      std::int64_t done = 0;
+      for (const auto& edges : tag_conflicts())
+        for (const auto& e : edges)
+          if (m_.point_alive(e[0]) && m_.point_alive(e[1]) && split(e[0], e[1], 0)) {
+            ++done;
+            ++st_.tag_splits;
+            break;
+          }
+      if (done == 0) break;
+    }
+    st_.tag_conflicts_left = static_cast<std::int64_t>(tag_conflicts().size());
+  }
+
   // ---- Phase 2: optimization ------------------------------------------------------------------
   double worst_quality() const {
     double w = 180;
@@ -299,7 +386,7 @@ class Refiner {
       for (const auto& [from, to] : {std::pair<Index, Index>{u, v}, std::pair<Index, Index>{v, u}}) {
         if (m_.support(from).kind == Support::kInputVertex) continue;
         const double lim = o_.split_ratio * target(to);
-        if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf)) {
+        if (m_.collapse_edge(from, to, o_.collapse_min_dihedral_deg, std::isfinite(lim) ? lim * lim : kInf)) {
           ++n;
           break;
         }
@@ -431,7 +518,8 @@ class Refiner {
       bool done = false;
       for (const auto& [from, to] : {std::pair<Index, Index>{a, b}, std::pair<Index, Index>{b, a}}) {
         if (m_.support(from).kind == Support::kInputVertex) continue;
-        if (m_.collapse_edge(from, to, 180.0, kInf)) {
+        const double lim = o_.split_ratio * target(to);
+        if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf)) {
           ++st_.collapses;
           done = true;
           break;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <set>
 #include <string>
 
 #include "bsptet/errors.h"
@@ -135,4 +137,116 @@ TEST(Tet10, StraightTetJacobianIsSixTimesItsVolume) {
   // Pulling mid-node m12 across the opposite face makes the element invalid.
   x[3 * 4 + 0] = -20;
   EXPECT_LT(tet10_min_jacobian(x), 0);
+}
+
+// A 12-gon prism (a faceted cylinder of radius 10, height 30): side triangles tag 0, top tag 1,
+// bottom tag 2. Its core mesh has no interior point: every tet has its corners on the rims, so
+// three or four of them on the side's triangles.
+SurfaceMesh tagged_prism() {
+  const int n = 12;
+  SurfaceMesh s;
+  for (int z = 0; z < 2; ++z)
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * 3.14159265358979323846 * i / n;
+      s.xyz.insert(s.xyz.end(), {10 * std::cos(a), 10 * std::sin(a), 30.0 * z});
+    }
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    s.tri.insert(s.tri.end(), {i, j, n + j, i, n + j, n + i});
+    s.tag.insert(s.tag.end(), {0, 0});
+  }
+  for (int i = 1; i + 1 < n; ++i) {
+    s.tri.insert(s.tri.end(), {n, n + i, n + i + 1, 0, i + 1, i});
+    s.tag.insert(s.tag.end(), {1, 2});
+  }
+  return s;
+}
+
+// The prism's output mesh: its boundary as a surface (outward faces of exactly one tet) and the
+// number of tets that FreeCAD's node-membership face search would misread: four corners on one
+// tag's boundary faces, or three that are not a boundary face of that tag. Tags are told by
+// place (caps at z = 0 and z = 30).
+int misread_tets(const TetMesh& m, SurfaceMesh* boundary) {
+  static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
+  for (Index t = 0; t < m.num_tets(); ++t) {
+    const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
+    for (const auto& o : outward) {
+      std::array<Index, 3> f{q[o[0]], q[o[1]], q[o[2]]}, key = f;
+      std::sort(key.begin(), key.end());
+      if (!faces.erase(key)) faces.emplace(key, f);
+    }
+  }
+  boundary->xyz = m.xyz;
+  boundary->tri.clear();
+  std::map<std::array<Index, 3>, int> tag_of_face;
+  std::vector<std::set<int>> point_tags(static_cast<std::size_t>(m.num_points()));
+  for (const auto& [key, f] : faces) {
+    boundary->tri.insert(boundary->tri.end(), f.begin(), f.end());
+    const double z0 = m.point(f[0]).z, z1 = m.point(f[1]).z, z2 = m.point(f[2]).z;
+    const int tag = (z0 == 0 && z1 == 0 && z2 == 0) ? 2 : (z0 == 30 && z1 == 30 && z2 == 30) ? 1 : 0;
+    tag_of_face[key] = tag;
+    for (Index v : f) point_tags[static_cast<std::size_t>(v)].insert(tag);
+  }
+  int misread = 0;
+  for (Index t = 0; t < m.num_tets(); ++t) {
+    const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
+    for (int tag = 0; tag < 3; ++tag) {
+      std::vector<Index> on;
+      for (int k = 0; k < 4; ++k)
+        if (point_tags[static_cast<std::size_t>(q[k])].count(tag)) on.push_back(q[k]);
+      std::array<Index, 3> f{on.size() > 0 ? on[0] : -1, on.size() > 1 ? on[1] : -1, on.size() > 2 ? on[2] : -1};
+      std::sort(f.begin(), f.end());
+      const auto it = tag_of_face.find(f);
+      if (on.size() == 4 || (on.size() == 3 && (it == tag_of_face.end() || it->second != tag))) {
+        ++misread;
+        break;
+      }
+    }
+  }
+  return misread;
+}
+
+// With a projection hook (the FreeCAD case: points go onto the true cylinder and planes) every
+// offending tet is mended; the mesh stays valid.
+TEST(QualityRefine, SeparateFaceTagsLeavesOnlyTrueBoundaryFacesOnEachTag) {
+  const SurfaceMesh s = tagged_prism();
+  const TetMesh core = tetrahedralize(s, MeshOptions{});
+  ASSERT_TRUE(check_mesh(s, core).valid);
+  SurfaceMesh b;
+  ASSERT_GT(misread_tets(core, &b), 0);
+  RefineOptions o;
+  o.max_passes = 0;
+  o.optimize_rounds = 0;
+  o.separate_face_tags = true;
+  o.projection = [](const Vec3& p, std::int32_t tag, std::int32_t other) {
+    if (tag != 0 && other != 0) return p;  // on a cap: the rounded midpoint is on its plane
+    const double r = std::hypot(p.x, p.y);
+    return Vec3{10 * p.x / r, 10 * p.y / r, p.z};
+  };
+  RefineStats st;
+  const TetMesh m = refine_quality(s, core, o, &st);
+  EXPECT_GT(st.tag_splits, 0);
+  EXPECT_EQ(st.tag_conflicts_left, 0);
+  EXPECT_EQ(misread_tets(m, &b), 0);
+  EXPECT_TRUE(check_mesh(b, m).valid);
+}
+
+// Exact mode cannot split the caps' input edges (no double lies exactly on most of them): what is
+// left is counted honestly, and the mesh is still an exact mesh of the input.
+TEST(QualityRefine, SeparateFaceTagsReportsWhatExactModeCannotMend) {
+  const SurfaceMesh s = tagged_prism();
+  const TetMesh core = tetrahedralize(s, MeshOptions{});
+  RefineOptions o;
+  o.max_passes = 0;
+  o.optimize_rounds = 0;
+  o.separate_face_tags = true;
+  RefineStats st;
+  const TetMesh m = refine_quality(s, core, o, &st);
+  SurfaceMesh b;
+  const int left = misread_tets(m, &b);
+  EXPECT_TRUE(check_mesh(s, m).valid);
+  EXPECT_GT(st.tag_splits, 0);
+  EXPECT_EQ(st.tag_conflicts_left, left);
+  EXPECT_LT(left, misread_tets(core, &b));
 }

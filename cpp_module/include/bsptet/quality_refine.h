@@ -21,6 +21,7 @@
 //     raise the smallest dihedral angle locally, tets with a radius-edge ratio above the bound get
 //     their shortest edge collapsed or their longest edge split. Rounds stop when nothing changes
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
+//  2b. separate_face_tags (optional): see the option;
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
 // Deterministic: edges and tets are visited in sorted order; no randomness.
 #pragma once
@@ -48,17 +49,32 @@ struct RefineOptions {
   /// How fast the target grows away from smaller sizes: at most `grading` per unit length.
   double grading = 0.5;
   /// An edge is split when longer than split_ratio * target (1.0 would make `size` a strict
-  /// maximum; about sqrt 2 matches the element counts of Gmsh and TetGen at the same size).
-  double split_ratio = 1.4;
+  /// maximum). Midpoint bisection leaves points much closer than the longest edge: with 1.4 the
+  /// median edge came out at 0.56 h and 4 to 9 times Gmsh's tets at its CharacteristicLengthMax
+  /// = h; with 2.0 (and the collapses below) the median edge is about 0.8 h, Gmsh's 1.0 h (its
+  /// edges reach 2 h), and the counts 1.2 to 3 times Gmsh's (docs/quality-stage.md).
+  double split_ratio = 2.0;
   /// Edges shorter than collapse_ratio * target are collapsed where a Steiner point can go (never
-  /// making the worst tet around worse, nor an edge longer than split_ratio * target).
-  double collapse_ratio = 0.5;
+  /// making an edge longer than split_ratio * target, and see collapse_min_dihedral_deg).
+  double collapse_ratio = 0.8;
+  /// A collapse is applied when its new tets' smallest dihedral angle is at least
+  /// min(collapse_min_dihedral_deg, the worst tet's around the point before); degrees. 180: a
+  /// collapse never makes the worst tet around worse (many short edges then stay).
+  double collapse_min_dihedral_deg = 10;
   /// Tets whose circumradius / shortest edge exceeds this are refined (0: no bound). TetGen's -q
   /// default is 2.0; 1.414 is stricter.
   double radius_edge_bound = 0;
   /// The optimization stops when the smallest dihedral angle reaches this (degrees; 0: it runs
   /// until no operation helps or optimize_rounds).
   double min_dihedral_deg = 0;
+  /// Make the mesh readable by FEM pre-processors that find the element faces on a CAD face by
+  /// node membership alone (FreeCAD's getccxVolumesByFace and its CalculiX writer: a tet counts
+  /// as having a face on face tag T when exactly three of its corners lie on T). After this step
+  /// no tet has four corners on one tag's boundary triangles, and a tet with three corners on tag
+  /// T has them as one of its boundary faces of tag T. Done by splitting, per offending tet, an
+  /// edge between two such corners that is not an edge of a boundary face of tag T (an interior
+  /// edge, or an edge of another tag's face: the new point lies off T). Only with face tags.
+  bool separate_face_tags = false;
   /// 1: linear tets; 2: 10-node tets (tet10.h).
   int order = 1;
   int max_passes = 40;       ///< size passes at most
@@ -85,6 +101,8 @@ struct RefineStats {
   std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
   std::int64_t size_passes = 0, optimize_rounds = 0;
   std::int64_t long_edges_left = 0;      ///< edges still longer than split_ratio * target
+  std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split
+  std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
   double seconds = 0;
 };
