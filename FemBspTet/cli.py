@@ -5,8 +5,11 @@
                    [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
                    [--max-memory SIZE] [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
+    fembsptet compare INPUT [--size H] [--json FILE] [--plot FILE.png] [--timeout S] [--keep DIR]
+    fembsptet benchmark MODELS_OR_FOLDERS... [--report FILE.md] [--divisions N] [--timeout S]
 
-Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
+``compare`` exits 0 once its table is made, whatever each mesher did (a failing, missing or
+timed-out mesher is a row that says so). Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
 mesh is not valid, and for a run over its memory budget; 1 internal failure (also a crash of the
 native code); 124 time limit reached (--timeout); 130 interrupted (Ctrl-C, SIGTERM).
 ``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.supervisor`): Ctrl-C,
@@ -215,24 +218,10 @@ def _cmd_mesh(args):
 
 
 def _tetgen_table(surfaces, stats):
-    """Our counts beside `tetgen -pY` on the same surface(s)."""
-    from .compare.tetgen_backend import run_tetgen, tetgen_available
+    """Our counts beside `tetgen -pY` on the same surface(s) (compare/comparison.py)."""
+    from .compare.comparison import format_rows, row_from_stats, tetgen_pY_row
 
-    if not tetgen_available():
-        return "tetgen is not installed: no comparison (run scripts/setup.sh)"
-    runs = [run_tetgen(s, "pY") for s in surfaces]
-    tg_points = sum(len(r.mesh.points) for r in runs)
-    tg_tets = sum(len(r.mesh.tets) for r in runs)
-    tg_steiner = sum(r.steiner_points for r in runs)
-    tg_seconds = sum(r.seconds for r in runs)
-    rows = [
-        ("", "FemBspTet", "tetgen -pY"),
-        ("points", stats["points"], tg_points),
-        ("tets", stats["tets"], tg_tets),
-        ("steiner points", stats["steiner_points"], tg_steiner),
-        ("seconds", f"{stats['seconds_total']:.3f}", f"{tg_seconds:.3f}"),
-    ]
-    return "\n".join(f"{a:<16s}{b!s:>12s}{c!s:>14s}" for a, b, c in rows)
+    return format_rows([row_from_stats(stats), tetgen_pY_row(surfaces)])
 
 
 def _summary(report):
@@ -302,6 +291,58 @@ def _cmd_check(args):
     return 0
 
 
+def _positive_option(value, option):
+    if value is not None and not (value > 0 and math.isfinite(value)):
+        raise InputError(f"{option} must be a positive number, got {value}")
+
+
+def _cmd_compare(args):
+    """Our mesher, TetGen and Gmsh on the same surface: one table (compare/comparison.py)."""
+    from .compare.comparison import MESHERS, compare, format_table, plot_histograms, write_json
+
+    _positive_option(args.size, "--size")
+    _positive_option(args.timeout, "--timeout")
+    meshers = tuple(m for m in args.meshers.split(",") if m) if args.meshers else MESHERS
+    unknown = set(meshers) - set(MESHERS)
+    if unknown:
+        raise InputError(f"unknown mesher(s) {', '.join(sorted(unknown))}; known: "
+                         + ", ".join(MESHERS))
+    for out in (args.json, args.plot):
+        if out and not os.path.isdir(os.path.dirname(os.path.abspath(out))):
+            raise InputError("the output directory does not exist", where=out)
+    surfaces = load_input(args.input, size=args.size)
+    result = compare(surfaces, size=args.size, timeout=args.timeout, workdir=args.keep,
+                     meshers=meshers, source=args.input)
+    print(format_table(result))
+    if args.json:
+        write_json(args.json, result)
+    if args.plot:
+        plot_histograms(args.plot, result)
+    return 0
+
+
+def _cmd_benchmark(args):
+    """``compare`` over folders of models, as a markdown report (compare/benchmark.py)."""
+    from .compare.benchmark import model_paths, run_benchmark, write_report
+    from .compare.comparison import MESHERS
+
+    _positive_option(args.divisions, "--divisions")
+    _positive_option(args.timeout, "--timeout")
+    if not os.path.isdir(os.path.dirname(os.path.abspath(args.report))):
+        raise InputError("the output directory does not exist", where=args.report)
+    paths = model_paths(args.models)
+    if not paths:
+        raise InputError("no models found (" + ", ".join(SURFACE_EXTENSIONS + CAD_EXTENSIONS)
+                         + ")")
+    meshers = tuple(m for m in args.meshers.split(",") if m) if args.meshers else MESHERS
+    entries = run_benchmark(paths, timeout=args.timeout, divisions=args.divisions,
+                            meshers=meshers, log=lambda line: print(line, flush=True))
+    command = "fembsptet " + " ".join(args.raw_argv)
+    png = write_report(args.report, entries, command=command)
+    print(f"report: {args.report}" + (f" (+ {png})" if png else ""))
+    return 0
+
+
 def build_parser():
     p = argparse.ArgumentParser(
         prog="fembsptet",
@@ -356,6 +397,41 @@ def build_parser():
     c.add_argument("--json", action="store_true", help="print the full report as JSON")
     c.add_argument("--max-messages", type=int, default=20, help="problems listed (default 20)")
     c.set_defaults(func=_cmd_check)
+
+    from .compare.process import DEFAULT_TIMEOUT
+
+    k = sub.add_parser("compare", help="our mesher, tetgen and gmsh on the same surface: a table")
+    k.add_argument("input", help="surface (.off .stl .obj .ply) or CAD (.step .stp .brep .iges); "
+                                 "a CAD file is tessellated once and every mesher gets the same "
+                                 "triangles")
+    k.add_argument("--size", type=float, default=None,
+                   help="element size h: our quality stage at h, tetgen -pq1.414a<h^3/(6 sqrt "
+                        "2)> and gmsh at CharacteristicLengthMax h (gmsh remeshes the surface); "
+                        "without it: our default mesh, tetgen -pY and gmsh filling the surface "
+                        "(at the mean input edge length)")
+    k.add_argument("--json", metavar="FILE", default=None, help="write the table as JSON")
+    k.add_argument("--plot", metavar="FILE.png", default=None,
+                   help="draw the dihedral-angle histograms side by side (matplotlib)")
+    k.add_argument("--timeout", type=float, default=DEFAULT_TIMEOUT,
+                   help=f"seconds each mesher may run (default {DEFAULT_TIMEOUT:g})")
+    k.add_argument("--keep", metavar="DIR", default=None,
+                   help="keep every mesher's input and mesh files in DIR")
+    k.add_argument("--meshers", default=None,
+                   help="comma-separated subset of ours,tetgen-pY,tetgen-pq,gmsh (default: all)")
+    k.set_defaults(func=_cmd_compare)
+
+    b = sub.add_parser("benchmark", help="compare over folders of models: a markdown report")
+    b.add_argument("models", nargs="+", help="model files and folders of models")
+    b.add_argument("--report", default="compare-report.md",
+                   help="markdown report (default compare-report.md; the histograms go to "
+                        "the same name with .png)")
+    b.add_argument("--divisions", type=float, default=None,
+                   help="mesh every model at size h = bounding-box diagonal / N (default: the "
+                        "default meshes, as compare without --size)")
+    b.add_argument("--timeout", type=float, default=300.0,
+                   help="seconds each mesher may run on one model (default 300)")
+    b.add_argument("--meshers", default=None, help="as for compare")
+    b.set_defaults(func=_cmd_benchmark)
     return p
 
 
@@ -402,6 +478,7 @@ def main(argv=None, supervise=True):
     """The command line. ``supervise=False`` runs ``mesh`` in this process (no --timeout, no
     memory watch, no crash isolation; for callers that supervise it themselves)."""
     args = build_parser().parse_args(argv)
+    args.raw_argv = list(sys.argv[1:] if argv is None else argv)
     if args.command == "mesh" and supervise:
         return _run_reporting(_supervised_mesh, args)
     if args.command == "mesh" and args.timeout is not None:

@@ -164,8 +164,8 @@ class MeshResult:
     face_names:         ``"Face<k+1>"`` for every face of the shape.
     stats:              the core's stats (``cli.STATS_KEYS`` and more) plus ``projected_nodes``,
                         ``max_projection_mm``, ``seconds_total``, ``linear_deflection``.
-    tetgen:             None, or {"command", "points", "tets", "steiner_points", "seconds"} or
-                        {"command", "error"}.
+    tetgen:             None, or the ``tetgen -pY`` row of the comparison as a dict
+                        (:func:`FemBspTet.compare.comparison.row_dict`).
     notes:              things the user should know (e.g. a parameter the core cannot honour).
     """
 
@@ -353,21 +353,12 @@ def shape_face_names(projection):
 
 
 def run_tetgen_comparison(surfaces):
-    """``tetgen -pY`` on each surface: summed counts, or an ``error`` entry (never raises)."""
-    from .compare.tetgen_backend import run_tetgen, tetgen_available
+    """``tetgen -pY`` on the surfaces: the comparison's row (:func:`FemBspTet.compare.comparison.
+    tetgen_pY_row`) as a dict; a missing or failing TetGen is a row with ``status`` and
+    ``message`` (never raises)."""
+    from .compare.comparison import row_dict, tetgen_pY_row
 
-    command = "tetgen -" + TETGEN_SWITCHES
-    if not tetgen_available():
-        return {"command": command, "error": "tetgen is not installed (run scripts/setup.sh)"}
-    try:
-        runs = [run_tetgen(s, TETGEN_SWITCHES) for s in surfaces]
-    except InternalError as e:
-        return {"command": command, "error": str(e)}
-    return {"command": command,
-            "points": int(sum(len(r.mesh.points) for r in runs)),
-            "tets": int(sum(len(r.mesh.tets) for r in runs)),
-            "steiner_points": int(sum(r.steiner_points for r in runs)),
-            "seconds": float(sum(r.seconds for r in runs))}
+    return row_dict(tetgen_pY_row(surfaces))
 
 
 # ------------------------------------------------------------------------------------------

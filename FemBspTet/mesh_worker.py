@@ -44,6 +44,16 @@ from .errors import InputError, InternalError, MeshingCancelled
 #: The checkout (the directory that holds the FemBspTet package).
 CHECKOUT_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
+def worker_env():
+    """Environment of a worker interpreter: this checkout first on its PYTHONPATH, and no
+    PYTHONHOME (FreeCAD's own, if any, is not the worker's)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = CHECKOUT_DIR + (os.pathsep + env["PYTHONPATH"]
+                                        if env.get("PYTHONPATH") else "")
+    env.pop("PYTHONHOME", None)
+    return env
+
+
 _ERROR_TYPES = {"InputError": InputError, "InternalError": InternalError,
                 "MeshingCancelled": MeshingCancelled}
 
@@ -93,11 +103,7 @@ class MeshJob:
             from .preferences import worker_python
 
             self._python = worker_python()
-        env = dict(os.environ)
-        env["PYTHONPATH"] = CHECKOUT_DIR + (os.pathsep + env["PYTHONPATH"]
-                                            if env.get("PYTHONPATH") else "")
-        env.pop("PYTHONHOME", None)  # FreeCAD's own, if any, is not the worker's
-        return [self._python, "-m", "FemBspTet.mesh_worker", self._dir], env
+        return [self._python, "-m", "FemBspTet.mesh_worker", self._dir], worker_env()
 
     def start(self):
         if self._proc is not None:

@@ -69,8 +69,29 @@ RESULT_PROPERTIES = (
     ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the same surface"),
     ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the same surface"),
     ("App::PropertyInteger", "TetGenSteinerPoints", "TetGen's Steiner points"),
+    ("App::PropertyInteger", "TetGenBoundarySteinerPoints", "TetGen's Steiner points on the "
+     "surface"),
+    ("App::PropertyFloat", "TetGenMinDihedralAngle", "Smallest dihedral angle of TetGen's mesh"),
+    ("App::PropertyFloat", "TetGenMaxRadiusEdgeRatio", "Largest radius-edge ratio of TetGen's "
+     "mesh"),
     ("App::PropertyFloat", "TetGenTime", "TetGen's seconds"),
+    ("App::PropertyFloat", "TetGenPeakMemory", "Peak memory of the TetGen process (MB)"),
+    ("App::PropertyBool", "TetGenValid", "Our exact checker accepts TetGen's mesh"),
 )
+
+#: Result property of each field of a comparison row (``compare.comparison.Row``), for our mesh
+#: and for TetGen's: ``mesher_tools.apply_result`` fills them, the task panel's table reads them.
+ROW_PROPERTIES = {
+    "ours": {"nodes": "Nodes", "tets": "Tetrahedra", "steiner_points": "SteinerPoints",
+             "steiner_boundary": "BoundarySteinerPoints", "min_dihedral_deg": "MinDihedralAngle",
+             "max_radius_edge_ratio": "MaxRadiusEdgeRatio", "seconds": "MeshingTime"},
+    "tetgen-pY": {"command": "TetGenCommand", "nodes": "TetGenNodes", "tets": "TetGenTetrahedra",
+                  "steiner_points": "TetGenSteinerPoints",
+                  "steiner_boundary": "TetGenBoundarySteinerPoints",
+                  "min_dihedral_deg": "TetGenMinDihedralAngle",
+                  "max_radius_edge_ratio": "TetGenMaxRadiusEdgeRatio", "seconds": "TetGenTime",
+                  "peak_rss_mb": "TetGenPeakMemory", "valid": "TetGenValid"},
+}
 
 
 def add_properties(obj):

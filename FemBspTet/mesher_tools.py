@@ -91,15 +91,33 @@ def apply_result(obj, result, femmesh=None):
     obj.MaxRadiusEdgeRatio = float(st.get("max_radius_edge_ratio") or 0.0)
     obj.MeshingTime = float(st.get("seconds_total") or 0.0)
     obj.MeshNotes = [str(n) for n in result.notes]
-    tg = result.tetgen or {}
-    obj.TetGenCommand = str(tg.get("command", "")) + (
-        " failed: %s" % tg["error"] if "error" in tg else "")
-    obj.TetGenNodes = int(tg.get("points", 0))
-    obj.TetGenTetrahedra = int(tg.get("tets", 0))
-    obj.TetGenSteinerPoints = int(tg.get("steiner_points", 0))
-    obj.TetGenTime = float(tg.get("seconds", 0.0))
+    set_tetgen_properties(obj, result.tetgen)
     obj.MeshStatus = "meshed: %d nodes, %d %s" % (
         obj.Nodes, obj.Tetrahedra, "tet10" if result.mesh.tets.shape[1] == 10 else "tet4")
+
+
+def set_tetgen_properties(obj, row):
+    """The TetGen result properties from the comparison's ``tetgen -pY`` row (a dict,
+    :func:`FemBspTet.compare.comparison.row_dict`), or cleared when ``row`` is None. A row
+    without a mesh leaves the figures 0 and says why in ``TetGenCommand``."""
+    from .mesher_object import ROW_PROPERTIES, RESULT_PROPERTIES
+
+    kinds = {name: kind for kind, name, _tip in RESULT_PROPERTIES}
+    row = row or {}
+    for field, prop in ROW_PROPERTIES["tetgen-pY"].items():
+        value = row.get(field) if row.get("status", "ok") == "ok" else None
+        kind = kinds[prop]
+        if kind == "App::PropertyString":
+            value = str(row.get(field) or "")
+            if row.get("status", "ok") != "ok":
+                value += " %s: %s" % (row["status"], row.get("message", ""))
+        elif kind == "App::PropertyInteger":
+            value = int(value or 0)
+        elif kind == "App::PropertyFloat":
+            value = float(value or 0.0)
+        else:
+            value = bool(value)
+        setattr(obj, prop, value)
 
 
 def mesh_shape(shape, **options):

@@ -11,17 +11,12 @@ and the TetGen comparison table.
 * OK writes the parameters and closes; it is refused while a run is going (Stop it first).
 """
 
-import math
-
 from .errors import BspTetError, MeshingCancelled
 
-#: Rows of the comparison table: (label, our stats key, TetGen key).
-COMPARISON_ROWS = (
-    ("nodes", "points_total", "points"),
-    ("tetrahedra", "tets", "tets"),
-    ("Steiner points", "steiner_points", "steiner_points"),
-    ("seconds", "seconds_total", "seconds"),
-)
+#: Fields of the comparison rows the table shows (``compare.comparison.COLUMNS``; the values
+#: come from the object's result properties, ``mesher_object.ROW_PROPERTIES``).
+TABLE_FIELDS = ("nodes", "tets", "steiner_interior", "steiner_boundary", "min_dihedral_deg",
+                "max_radius_edge_ratio", "seconds", "valid")
 POLL_INTERVAL_MS = 100
 
 
@@ -96,10 +91,15 @@ class TaskPanelMeshBspTet:
         self.stats = QtGui.QLabel("")
         self.stats.setWordWrap(True)
         self.stats.setTextInteractionFlags(self.stats.textInteractionFlags() | 1)
-        self.table = QtGui.QTableWidget(len(COMPARISON_ROWS), 2)
+        from .compare.comparison import COLUMNS
+
+        headers = dict((key, head) for key, head, _fmt in COLUMNS)
+        self.table = QtGui.QTableWidget(len(TABLE_FIELDS), 2)
         self.table.setHorizontalHeaderLabels(["FemBspTet", "tetgen -pY"])
-        self.table.setVerticalHeaderLabels([r[0] for r in COMPARISON_ROWS])
+        self.table.setVerticalHeaderLabels([headers[k] for k in TABLE_FIELDS])
         self.table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
+        rows_height = sum(self.table.rowHeight(r) for r in range(len(TABLE_FIELDS)))
+        self.table.setMinimumHeight(rows_height + self.table.horizontalHeader().height() + 4)
         res_layout.addWidget(self.stats)
         res_layout.addWidget(self.table)
         layout.addWidget(res)
@@ -326,26 +326,43 @@ class TaskPanelMeshBspTet:
                      % (o.MinDihedralAngle, o.MaxRadiusEdgeRatio, o.MeshingTime)]
             lines += ["note: %s" % n for n in o.MeshNotes]
             self.stats.setText("\n".join(lines))
-        ours = {"points_total": o.Nodes, "tets": o.Tetrahedra, "steiner_points": o.SteinerPoints,
-                "seconds_total": o.MeshingTime}
-        tetgen = {"points": o.TetGenNodes, "tets": o.TetGenTetrahedra,
-                  "steiner_points": o.TetGenSteinerPoints, "seconds": o.TetGenTime}
-        have_tetgen = bool(o.TetGenCommand) and "failed" not in o.TetGenCommand
-        for row, (_label, ours_key, tg_key) in enumerate(COMPARISON_ROWS):
-            self.table.setItem(row, 0, QtGui.QTableWidgetItem(_fmt(ours[ours_key]) if o.Nodes
-                                                              else "-"))
-            self.table.setItem(row, 1, QtGui.QTableWidgetItem(
-                _fmt(tetgen[tg_key]) if have_tetgen else "-"))
+        ours, tetgen = object_rows(o)
+        for row, field in enumerate(TABLE_FIELDS):
+            for col, r in enumerate((ours, tetgen)):
+                text = r.cell(field) if r is not None else "-"
+                self.table.setItem(row, col, QtGui.QTableWidgetItem(text))
         if o.TetGenCommand:
             self.table.setToolTip(o.TetGenCommand)
 
     def comparison_table(self):
         """The table's cells as text rows (label, ours, TetGen): for tests and scripts."""
         rows = []
-        for row, (label, _a, _b) in enumerate(COMPARISON_ROWS):
+        for row in range(self.table.rowCount()):
             cells = [self.table.item(row, c) for c in (0, 1)]
+            label = self.table.verticalHeaderItem(row).text()
             rows.append((label,) + tuple(c.text() if c is not None else "" for c in cells))
         return rows
+
+
+def object_rows(obj):
+    """``(ours, tetgen)``: comparison rows (``compare.comparison.Row``) rebuilt from the
+    object's result properties, or None for a side without a mesh."""
+    from .compare.comparison import OURS, TETGEN_PY, Row
+    from .mesher_object import ROW_PROPERTIES
+
+    rows = []
+    for mesher, present in ((OURS, obj.Nodes > 0), (TETGEN_PY, obj.TetGenTetrahedra > 0)):
+        if not present:
+            rows.append(None)
+            continue
+        props = ROW_PROPERTIES[mesher]
+        values = {f: getattr(obj, p) for f, p in props.items() if f != "steiner_points"}
+        values["steiner_interior"] = getattr(obj, props["steiner_points"]) - \
+            values["steiner_boundary"]
+        values.setdefault("valid", True)  # ours: checked exactly before it is returned
+        values.setdefault("command", "fembsptet")
+        rows.append(Row(mesher=mesher, **values))
+    return tuple(rows)
 
 
 def _as_bsptet_error(error):
@@ -355,11 +372,3 @@ def _as_bsptet_error(error):
     from .errors import InternalError
 
     return InternalError("unexpected %s: %s" % (type(error).__name__, error))
-
-
-def _fmt(value):
-    if isinstance(value, float) and not float(value).is_integer():
-        return "%.3f" % value
-    if isinstance(value, float) and math.isfinite(value):
-        return "%.3f" % value
-    return str(value)

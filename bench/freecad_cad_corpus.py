@@ -17,21 +17,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from FemBspTet.cad_tessellation import CAD_FORMATS  # noqa: E402
+from FemBspTet.compare.benchmark import model_paths  # noqa: E402
 from FemBspTet.errors import BspTetError  # noqa: E402
 from FemBspTet.freecad_env import import_freecad  # noqa: E402
 from FemBspTet.mesh_pipeline import MeshParameters  # noqa: E402
 from FemBspTet.mesh_worker import MeshJob  # noqa: E402
-
-
-def cad_files(args):
-    out = []
-    for a in args:
-        if os.path.isdir(a):
-            out += sorted(os.path.join(a, f) for f in os.listdir(a)
-                          if os.path.splitext(f)[1].lower() in CAD_FORMATS)
-        else:
-            out.append(a)
-    return out
 
 
 def main():
@@ -45,7 +35,7 @@ def main():
     import Part
 
     rows = [("file", "solids", "faces", "result", "nodes", "tets", "seconds")]
-    for path in cad_files(args.inputs):
+    for path in model_paths(args.inputs, CAD_FORMATS):
         name = os.path.basename(path)
         t0 = time.perf_counter()
         try:

@@ -5,12 +5,13 @@
                               [--timeout S] [--png FILE] [--markdown FILE]
 
 For each surface (default: tests/data/paper and tests/data/corpus), h = bounding-box diagonal /
-divisions. Ours: the core then the quality stage at size h (``core.tetrahedralize(surface,
-{"size": h, "surface_points": mode})``), once per mode, each in a child process with a timeout;
-every mesh is checked exactly before it is returned (exact mode: against the input surface;
-rounded: against its own boundary). TetGen: ``tetgen -pq1.414a<V>`` with V = h^3 / (6 sqrt 2)
-(the volume of the regular tet of edge h), its mesh checked exactly against the input surface too
-(its surface Steiner points are rounded, so it usually fails that check: printed, not hidden).
+divisions. Both run through the comparison of ``fembsptet compare`` (FemBspTet/compare/
+comparison.py), each in a process of its own with a timeout, and every mesh is read back and
+evaluated by the same code. Ours: the core then the quality stage at size h (``{"size": h,
+"surface_points": mode}``), once per mode. TetGen: ``tetgen -pq1.414a<V>`` with V = h^3 /
+(6 sqrt 2) (the volume of the regular tet of edge h). "valid" is our exact checker: against the
+input surface for a mesh without boundary Steiner points, else against the mesh's own boundary
+(TetGen's surface Steiner points are rounded; so are ours in rounded mode).
 Printed per model: validity, tets, min / 1st percentile dihedral angle, seconds, and the ratios
 ours / TetGen; then the share of models where our min dihedral >= TetGen's, how many tet counts
 are within +-20 %, and the median count ratio. The PNG puts the dihedral histograms side by side.
@@ -18,19 +19,16 @@ Models the core cannot mesh are listed with the core's message.
 """
 
 import argparse
-import multiprocessing as mp
 import os
 import statistics
 import sys
-import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from FemBspTet import core  # noqa: E402
-from FemBspTet.compare.tetgen_backend import regular_tet_volume, run_tetgen  # noqa: E402
+from FemBspTet.compare.comparison import OURS, TETGEN_PQ, compare  # noqa: E402
 from FemBspTet.surface_io import read_surface  # noqa: E402
 
 
@@ -45,43 +43,23 @@ def _models(args):
     return paths
 
 
-def _ours_child(path, h, mode, queue):
-    try:
-        surface = read_surface(path)
-        t0 = time.perf_counter()
-        mesh, st = core.tetrahedralize(surface, options={"size": h, "surface_points": mode})
-        seconds = time.perf_counter() - t0
-        queue.put({"tets": int(len(mesh.tets)), "min": st["min_dihedral_deg"],
-                   "p1": st["p1_dihedral_deg"], "hist": st["dihedral_histogram"],
-                   "seconds": seconds, "valid": st["valid"],
-                   "no_exact": st.get("refine", {}).get("splits_no_exact_point", 0)})
-    except Exception as exc:  # noqa: BLE001 - reported per model
-        queue.put({"error": str(exc).splitlines()[0][:120]})
+def _as_dict(row):
+    """A comparison row (FemBspTet.compare.comparison.Row) as this script's dict."""
+    if row.status != "ok":
+        return {"error": f"{row.status}: {row.message}"[:120]}
+    return {"tets": row.tets, "min": row.min_dihedral_deg, "p1": row.p1_dihedral_deg,
+            "hist": row.dihedral_histogram, "seconds": row.seconds, "valid": row.valid,
+            "command": row.command}
 
 
-def run_ours(path, h, mode, timeout):
-    queue = mp.Queue()
-    proc = mp.Process(target=_ours_child, args=(path, h, mode, queue))
-    proc.start()
-    proc.join(timeout)
-    if proc.is_alive():
-        proc.kill()
-        proc.join()
-        return {"error": f"timeout after {timeout:.0f} s"}
-    return queue.get() if not queue.empty() else {"error": f"exit {proc.exitcode}"}
+def run_ours(surface, h, mode, timeout):
+    row = compare(surface, size=h, timeout=timeout, meshers=(OURS,),
+                  ours_options={"surface_points": mode}).rows[0]
+    return _as_dict(row)
 
 
 def run_tg(surface, h, timeout):
-    v = regular_tet_volume(h)
-    try:
-        r = run_tetgen(surface, f"pq1.414a{v:.6g}", timeout=timeout)
-    except Exception as exc:  # noqa: BLE001
-        return {"error": str(exc).splitlines()[0][:120]}
-    rep = core.check_mesh(surface, r.mesh, max_messages=1)
-    q = rep["quality"]
-    return {"tets": int(len(r.mesh.tets)), "min": q["min_dihedral_deg"], "p1": q["p1_dihedral_deg"],
-            "hist": q["dihedral_histogram"], "seconds": r.seconds, "valid": rep["valid"],
-            "command": r.command}
+    return _as_dict(compare(surface, size=h, timeout=timeout, meshers=(TETGEN_PQ,)).rows[0])
 
 
 def main():
@@ -104,7 +82,7 @@ def main():
         h = float(np.linalg.norm(surface.points.max(0) - surface.points.min(0))) / args.divisions
         tg = None
         for mode in modes:
-            ours = run_ours(path, h, mode, args.timeout)
+            ours = run_ours(surface, h, mode, args.timeout)
             if "error" in ours:
                 print(f"{name:<22}{mode:<8}  core/refine failed: {ours['error']}")
                 rows.append({"name": name, "mode": mode, "ours": ours, "tg": None})
@@ -208,5 +186,4 @@ def _markdown(rows, summary, args):
 
 
 if __name__ == "__main__":
-    mp.set_start_method("fork")
     main()

@@ -14,6 +14,8 @@ PACKAGES=(
   python3-numpy python3-meshio python3-matplotlib
   # FreeCAD FEM and the peers we compare with or solve with
   freecad-python3 gmsh python3-gmsh tetgen calculix-ccx
+  # peak memory of each mesher's process in the comparison (GNU time)
+  time
 )
 
 missing=()

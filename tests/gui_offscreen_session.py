@@ -119,10 +119,11 @@ try:
         facts["tets_after_mesh"] = obj.FemMesh.VolumeCount
         facts["result_nodes_property"] = obj.Nodes
         facts["tetgen_tets_property"] = obj.TetGenTetrahedra
+        facts["tetgen_min_dihedral_property"] = obj.TetGenMinDihedralAngle
         facts["mesh_status"] = obj.MeshStatus
         shot = os.environ.get("FEMBSPTET_GUI_SCREENSHOT")
         if shot:
-            tp.form.resize(420, 760)
+            tp.form.resize(420, 900)
             tp.form.grab().save(shot)
 
     @step("stop keeps the previous mesh")

@@ -114,9 +114,12 @@ def test_mesh_prints_stats_and_tetgen_table(cli, tmp_path):
     head, _, table = r.stdout.partition("}\n")
     stats = json.loads(head + "}")
     assert stats["valid"] is True and stats["tets"] > 0
-    rows = {line[:16].strip(): line[16:].split() for line in table.splitlines() if line.strip()}
-    assert rows["tets"][0] == str(stats["tets"])
-    assert rows["steiner points"][0] == str(stats["steiner_points"])
+    lines = [line.split() for line in table.splitlines() if line.strip()]
+    heads, ours, tetgen = lines[0], lines[1], lines[2]
+    assert ours[0] == "FemBspTet" and tetgen[:2] == ["tetgen", "-pY"]
+    assert heads[:3] == ["mesher", "nodes", "tets"]
+    assert ours[2] == str(stats["tets"]) and ours[1] == str(stats["points"])
+    assert int(ours[3]) + int(ours[4]) == stats["steiner_points"]  # "Steiner in", "Steiner bd"
 
 
 def test_mesh_open_surface_names_the_triangle_and_writes_nothing(cli, tmp_path):

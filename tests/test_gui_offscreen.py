@@ -91,8 +91,12 @@ def test_task_panel_meshes_in_a_worker_and_shows_stats(facts):
     assert facts["panel_status"] == facts["mesh_status"]
     assert facts["panel_stats"].startswith("%d nodes, %d tetrahedra" % (n, t))
     table = {row[0]: row[1:] for row in facts["panel_table"]}
-    assert table["nodes"][0] == str(n) and table["tetrahedra"][0] == str(t)
-    assert int(table["tetrahedra"][1]) == facts["tetgen_tets_property"] > 0
+    # the rows and their labels are the comparison's (compare.comparison.COLUMNS)
+    assert table["nodes"][0] == str(n) and table["tets"][0] == str(t)
+    assert int(table["tets"][1]) == facts["tetgen_tets_property"] > 0
+    assert list(table["valid"]) == ["yes", "yes"]
+    assert float(table["min dih"][1]) == pytest.approx(facts["tetgen_min_dihedral_property"],
+                                                       abs=0.005)
 
 
 def test_stop_kills_the_worker_and_keeps_the_mesh(facts):

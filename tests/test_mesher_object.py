@@ -115,7 +115,30 @@ def test_run_mesher_tet4_smesh_conventions_and_face_nodes(doc, fc):
     assert obj.MeshStatus == "meshed: %d nodes, %d tet4" % (obj.Nodes, obj.Tetrahedra)
     assert obj.TetGenCommand == "tetgen -pY" and obj.TetGenTetrahedra > 0
     assert obj.TetGenNodes >= len(np.unique(result.boundary_faces))
+    # the properties are the comparison's tetgen -pY row (compare.comparison.tetgen_pY_row)
+    row = result.tetgen
+    assert row["status"] == "ok" and row["valid"] is True and obj.TetGenValid is True
+    assert (obj.TetGenNodes, obj.TetGenTetrahedra, obj.TetGenSteinerPoints,
+            obj.TetGenBoundarySteinerPoints) == (row["nodes"], row["tets"],
+                                                 row["steiner_points"], 0)
+    assert obj.TetGenMinDihedralAngle == row["min_dihedral_deg"] > 0
+    assert obj.TetGenPeakMemory == row["peak_rss_mb"] > 0
     assert obj.MeshingTime > 0 and obj.MinDihedralAngle >= 0
+
+
+def test_tetgen_properties_of_a_skipped_tetgen_row(doc, fc, monkeypatch, tmp_path):
+    from FemBspTet.mesh_pipeline import run_tetgen_comparison
+    from FemBspTet.mesher_tools import set_tetgen_properties
+    from FemBspTet.surface_io import read_surface
+    from conftest import paper_path
+
+    monkeypatch.setenv("PATH", str(tmp_path))  # no tetgen on it
+    row = run_tetgen_comparison([read_surface(paper_path("schoenhardt"))])
+    assert row["status"] == "skipped" and "tetgen is not installed" in row["message"]
+    obj = FemBspTet.make_mesher(doc, None, ElementOrder="1st")
+    set_tetgen_properties(obj, row)
+    assert obj.TetGenCommand.startswith("tetgen -pY skipped: tetgen is not installed")
+    assert (obj.TetGenTetrahedra, obj.TetGenNodes, obj.TetGenValid) == (0, 0, False)
 
 
 def assert_ccx_faces_are_the_boundary_faces(result, fem, shape, k):

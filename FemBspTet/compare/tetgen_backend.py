@@ -2,18 +2,17 @@
 
 ``run_tetgen(surface, switches)`` writes the surface as OFF with round-trip precision, runs
 ``tetgen -<switches>Q`` in a temporary directory, reads the mesh back and measures the wall time
-and the peak resident memory of that process alone (``os.wait4``).
+and the peak resident memory of that process alone (:func:`.process.run_measured`).
 """
 
 import dataclasses
 import os
 import shutil
-import subprocess
 import tempfile
-import time
 
 from ..errors import InternalError
 from ..mesh_types import Surface, TetMesh
+from .process import run_measured
 
 
 @dataclasses.dataclass
@@ -24,6 +23,7 @@ class TetgenResult:
     peak_rss_mb: float
     steiner_points: int  # output points - input points (TetGen -Y keeps every input point)
     output: str
+    mesh_path: str = ""  #: stem of the .node/.ele files (only meaningful with ``keep_dir``)
 
 
 def tetgen_path():
@@ -40,6 +40,12 @@ def regular_tet_volume(h: float) -> float:
     return h ** 3 / (6.0 * 2.0 ** 0.5)
 
 
+def quality_switches(h: float) -> str:
+    """TetGen's quality mesh at size h: radius-edge 1.414 and the volume of the regular tet of
+    edge h as the maximum tet volume (``pq1.414a<V>``)."""
+    return f"pq1.414a{regular_tet_volume(h):.6g}"
+
+
 def _write_off(path, surface: Surface):
     with open(path, "w") as f:
         f.write(f"OFF\n{len(surface.points)} {len(surface.triangles)} 0\n")
@@ -49,9 +55,11 @@ def _write_off(path, surface: Surface):
             f.write(f"3 {a} {b} {c}\n")
 
 
-def run_tetgen(surface: Surface, switches="pY", timeout=None, keep_dir=None) -> TetgenResult:
+def run_tetgen(surface: Surface, switches="pY", timeout=None, keep_dir=None,
+               name="surface") -> TetgenResult:
     """Runs TetGen on ``surface``. ``switches`` without the dash, e.g. "pY" or "pq1.414a0.01".
 
+    ``keep_dir``: work (and leave the files) there, as ``<name>.off`` and ``<name>.1.node/.ele``.
     Raises InternalError when TetGen is missing, fails or times out (the message carries its
     output).
     """
@@ -62,38 +70,26 @@ def run_tetgen(surface: Surface, switches="pY", timeout=None, keep_dir=None) -> 
 
     workdir = keep_dir or tempfile.mkdtemp(prefix="fembsptet_tetgen_")
     try:
-        src = os.path.join(workdir, "surface.off")
+        src = os.path.join(workdir, name + ".off")
         _write_off(src, surface)
-        cmd = [exe, f"-{switches}Q", src]
-        start = time.perf_counter()
-        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, cwd=workdir)
-        deadline = None if timeout is None else start + timeout
-        while True:
-            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
-            if pid != 0:
-                break
-            if deadline is not None and time.perf_counter() > deadline:
-                proc.kill()
-                os.wait4(proc.pid, 0)
-                raise InternalError(f"tetgen timed out after {timeout} s: {' '.join(cmd)}")
-            time.sleep(0.005)
-        seconds = time.perf_counter() - start
-        out = proc.stdout.read().decode(errors="replace")
-        proc.stdout.close()
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        if proc.returncode != 0:
+        run = run_measured([exe, f"-{switches}Q", src], timeout=timeout, cwd=workdir)
+        if run.timed_out:
+            raise InternalError(f"tetgen timed out after {timeout:g} s: {' '.join(run.command)}")
+        if run.returncode != 0:
             raise InternalError(
-                f"tetgen failed (exit {proc.returncode}) on {surface.source or 'the surface'}: "
-                f"{out.strip()[-500:]}"
+                f"tetgen failed (exit {run.returncode}) on {surface.source or 'the surface'}: "
+                f"{run.output.strip()[-500:]}"
             )
-        mesh = read_tetgen(os.path.join(workdir, "surface.1"))
+        stem = os.path.join(workdir, name + ".1")
+        mesh = read_tetgen(stem)
         return TetgenResult(
             mesh=mesh,
             command="tetgen -" + switches,
-            seconds=seconds,
-            peak_rss_mb=usage.ru_maxrss / 1024.0,
+            seconds=run.seconds,
+            peak_rss_mb=run.peak_rss_mb,
             steiner_points=len(mesh.points) - len(surface.points),
-            output=out,
+            output=run.output,
+            mesh_path=stem,
         )
     finally:
         if keep_dir is None:
