@@ -77,6 +77,105 @@ double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
   return best_s;
 }
 
+// The Chebyshev centre of a convex polytope {u : m_j . u >= d_j for all j} (m_j unit normals,
+// coordinates relative to some origin) clipped to the box |u_k| <= R: the point u that maximizes
+// its clearance s = min_j (m_j . u - d_j). Solved in doubles (a heuristic: every use is followed by
+// an exact check) as the dual LP, min sum b_j y_j subject to sum y_j A_j = (0, 0, 0, 1), y >= 0,
+// with primal rows A_j = (-m_j, 1), b_j = -d_j, by a two-phase tableau simplex with 4 rows; the
+// primal optimum (u, s) is the simplex multiplier vector of the optimal basis. Returns s (-inf when
+// the simplex fails).
+double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R, Vec3* out) {
+  std::vector<std::array<double, 4>> A;
+  std::vector<double> b;
+  for (const auto& [m, d] : hs) A.push_back({-m.x, -m.y, -m.z, 1.0}), b.push_back(-d);
+  for (int k = 0; k < 3; ++k)
+    for (double sg : {1.0, -1.0}) {
+      std::array<double, 4> row{0, 0, 0, 0};
+      row[k] = sg;
+      A.push_back(row), b.push_back(R);
+    }
+  A.push_back({0, 0, 0, 1}), b.push_back(R);
+  const std::size_t n = A.size(), cols = n + 4;  // y_j, then 4 artificials
+  std::vector<std::array<double, 4>> col(cols);  // tableau columns (B^-1 A_j)
+  for (std::size_t j = 0; j < n; ++j) col[j] = A[j];
+  for (int i = 0; i < 4; ++i) col[n + i] = {0, 0, 0, 0}, col[n + i][i] = 1.0;
+  std::array<double, 4> rhs{0, 0, 0, 1};
+  std::array<std::size_t, 4> basis{n, n + 1, n + 2, n + 3};
+  auto pivot = [&](int r, std::size_t e) {
+    const std::array<double, 4> pc = col[e];
+    const double p = pc[r];
+    for (auto& c : col) {
+      const double f = c[r] / p;
+      if (f == 0) continue;
+      for (int i = 0; i < 4; ++i) c[i] = i == r ? f : c[i] - f * pc[i];
+    }
+    const double f = rhs[r] / p;
+    for (int i = 0; i < 4; ++i) rhs[i] = i == r ? f : rhs[i] - f * pc[i];
+    basis[r] = e;
+  };
+  auto run = [&](const std::vector<double>& cost, bool allow_artificial) {
+    for (int iter = 0; iter < 500; ++iter) {
+      std::size_t enter = cols;
+      double best = -1e-12;
+      for (std::size_t j = 0; j < cols; ++j) {
+        if (!allow_artificial && j >= n) continue;
+        double red = cost[j];
+        for (int i = 0; i < 4; ++i) red -= cost[basis[i]] * col[j][i];
+        if (red < best) best = red, enter = j;
+      }
+      if (enter == cols) return true;
+      int leave = -1;
+      double ratio = INFINITY;
+      for (int i = 0; i < 4; ++i)
+        if (col[enter][i] > 1e-12 && rhs[i] / col[enter][i] < ratio) ratio = rhs[i] / col[enter][i], leave = i;
+      if (leave < 0) return false;  // unbounded dual: the polytope is empty
+      pivot(leave, enter);
+    }
+    return false;
+  };
+  std::vector<double> cost(cols, 0.0);
+  for (int i = 0; i < 4; ++i) cost[n + i] = 1.0;
+  if (!run(cost, true) || rhs[0] + rhs[1] + rhs[2] + rhs[3] > 1e-9) {
+    // artificial values left: infeasible dual (cannot happen with the box rows) or failure
+    double art = 0;
+    for (int i = 0; i < 4; ++i) art += basis[i] >= n ? rhs[i] : 0.0;
+    if (art > 1e-9) return -INFINITY;
+  }
+  for (int i = 0; i < 4; ++i)
+    if (basis[i] >= n) {
+      std::size_t e = cols;
+      for (std::size_t j = 0; j < n && e == cols; ++j)
+        if (std::fabs(col[j][i]) > 1e-9) e = j;
+      if (e == cols) return -INFINITY;
+      pivot(i, e);
+    }
+  for (std::size_t j = 0; j < n; ++j) cost[j] = b[j];
+  for (int i = 0; i < 4; ++i) cost[n + i] = 0.0;
+  if (!run(cost, false)) return -INFINITY;
+  // Multipliers: B^T pi = c_B (Gaussian elimination with partial pivoting).
+  double M[4][5];
+  for (int i = 0; i < 4; ++i) {
+    for (int k = 0; k < 4; ++k) M[i][k] = A[basis[i]][k];
+    M[i][4] = b[basis[i]];
+  }
+  for (int c = 0; c < 4; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < 4; ++r)
+      if (std::fabs(M[r][c]) > std::fabs(M[piv][c])) piv = r;
+    if (M[piv][c] == 0) return -INFINITY;
+    for (int k = 0; k < 5; ++k) std::swap(M[c][k], M[piv][k]);
+    for (int r = 0; r < 4; ++r)
+      if (r != c) {
+        const double f = M[r][c] / M[c][c];
+        for (int k = c; k < 5; ++k) M[r][k] -= f * M[c][k];
+      }
+  }
+  *out = {M[0][4] / M[0][0], M[1][4] / M[1][1], M[2][4] / M[2][2]};
+  double s = INFINITY;  // the clearance actually reached (recomputed, not trusted from the LP)
+  for (const auto& [m, d] : hs) s = std::min(s, m.x * out->x + m.y * out->y + m.z * out->z - d);
+  return s;
+}
+
 // The working tet complex: tets and boundary faces with vertex -> element lists.
 class TetComplex {
  public:
@@ -521,6 +620,47 @@ class TetComplex {
     }
     return fail("no double-precision point just inside keeps its tets positive");
   }
+  /// The half-spaces {u : m . u >= d} (m unit, u relative to `origin`) a point must be in to see
+  /// the outward faces `fs` of a cavity from inside (w makes (a, c, b, w) positive for face (a, b, c)).
+  std::vector<std::pair<Vec3, double>> seeing_half_spaces(const std::vector<std::array<Index, 3>>& fs,
+                                                          const Vec3& origin, double* size) {
+    std::vector<std::pair<Vec3, double>> hs;
+    *size = 0;
+    for (const auto& f : fs) {
+      const Vec3 a = geo_.rounded(f[0]), b = geo_.rounded(f[2]), c = geo_.rounded(f[1]);
+      const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, wx = c.x - a.x, wy = c.y - a.y, wz = c.z - a.z;
+      Vec3 m{uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx};
+      const double len = std::sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
+      if (!(len > 0)) continue;
+      m = {m.x / len, m.y / len, m.z / len};
+      hs.push_back({m, m.x * (a.x - origin.x) + m.y * (a.y - origin.y) + m.z * (a.z - origin.z)});
+      for (const Vec3& q : {a, b, c})
+        *size = std::max(*size, std::max({std::fabs(q.x - origin.x), std::fabs(q.y - origin.y), std::fabs(q.z - origin.z)}));
+    }
+    return hs;
+  }
+  /// PUSH (header comment): moves the interior Steiner point z to the Chebyshev centre of its
+  /// star's kernel (rounded to doubles) when that at least doubles its clearance from its link
+  /// faces (estimated in doubles); taken only if every new tet is positive (decided exactly).
+  bool push(Index z) {
+    if (z < np_ || !vb_[z].empty() || vt_[z].empty()) return false;
+    std::vector<Index> st = vt_[z];
+    std::sort(st.begin(), st.end());
+    std::vector<std::array<Index, 3>> link;
+    for (const auto& f : boundary_faces(st))
+      if (f[0] != z && f[1] != z && f[2] != z) link.push_back(f);
+    const Vec3 o = geo_.rounded(z);
+    double size = 0;
+    const auto hs = seeing_half_spaces(link, o, &size);
+    if (!(size > 0)) return false;
+    double now = INFINITY;
+    for (const auto& [m, d] : hs) now = std::min(now, -d);
+    Vec3 u;
+    const double s = chebyshev_centre(hs, size, &u);
+    if (!(s > 2 * std::max(now, 0.0)) || !(s > 0)) return false;
+    const Index w = geo_.add_explicit_point({o.x + u.x, o.y + u.y, o.z + u.z});
+    return try_substitute(z, w);
+  }
   /// Removes the interior Steiner point v by re-coning a cavity from its neighbour u: the cavity
   /// starts as v's star and takes the tet beyond every face u does not see (never across a surface
   /// face), at most `max_grow` times and up to `max_tets` tets. The cone from u over the cavity's
@@ -837,6 +977,14 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           }
           if (ok) break;
         }
+      }
+      if (!ok) {
+        // PUSH the interior Steiner points around v deeper (header comment), then try again: points
+        // left a few ulps from a surface plane through v close v's kernel.
+        bool pushed = false;
+        for (Index z : mesh.neighbours(v))
+          if (z >= np && mesh.labels(z).empty() && mesh.push(z)) pushed = true, ++st.pushed;
+        if (pushed) ok = mesh.relocate(v);
       }
       if (ok) {
         ++st.relocated;
