@@ -661,6 +661,115 @@ class TetComplex {
     const Index w = geo_.add_explicit_point({o.x + u.x, o.y + u.y, o.z + u.z});
     return try_substitute(z, w);
   }
+  /// RETETRAHEDRALIZE (header comment): removes the interior Steiner point v by filling a cavity
+  /// around it (v's star grown by `layers` layers of tets that share a face's three vertices with
+  /// it) with new tets over the cavity's boundary vertices only, found by a depth-first search over
+  /// the front (the boundary chain of what is left to fill) with at most `max_nodes` steps.
+  bool retetrahedralize(Index v, int layers, std::size_t max_tets, std::size_t max_nodes) {
+    if (v < np_ || !vb_[v].empty() || vt_[v].empty()) return false;
+    std::vector<Index> cav = vt_[v];
+    std::sort(cav.begin(), cav.end());
+    for (int layer = 0; layer < layers; ++layer) {
+      std::vector<Index> add;
+      for (const auto& f : boundary_faces(cav)) {
+        const Index beyond = tet_beyond(f, cav);
+        if (beyond >= 0) add.push_back(beyond);
+      }
+      if (add.empty()) break;
+      cav.insert(cav.end(), add.begin(), add.end());
+      std::sort(cav.begin(), cav.end());
+      cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
+      if (cav.size() > max_tets) return false;
+    }
+    const std::vector<std::array<Index, 3>> bnd = boundary_faces(cav);
+    std::vector<Index> verts;
+    for (const auto& f : bnd)
+      for (Index x : f) verts.push_back(x);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    // Vertices inside the cavity vanish: they must be interior Steiner points (v among them).
+    for (Index id : cav)
+      for (Index x : tets_[id])
+        if (!std::binary_search(verts.begin(), verts.end(), x) && (x < np_ || !vb_[x].empty())) return false;
+    // Front faces are stored rotated so that the smallest id comes first (orientation kept).
+    auto canon = [](std::array<Index, 3> f) {
+      const int i = f[0] < f[1] ? (f[0] < f[2] ? 0 : 2) : (f[1] < f[2] ? 1 : 2);
+      return std::array<Index, 3>{f[i], f[(i + 1) % 3], f[(i + 2) % 3]};
+    };
+    std::set<std::array<Index, 3>> front;
+    for (const auto& f : bnd) front.insert(canon(f));
+    std::map<std::array<Index, 3>, std::vector<Index>> apexes;  // face -> vertices on its inner side
+    auto candidates = [&](const std::array<Index, 3>& f) -> const std::vector<Index>& {
+      auto it = apexes.find(f);
+      if (it != apexes.end()) return it->second;
+      std::vector<Index> out;
+      for (Index p : verts)
+        if (p != f[0] && p != f[1] && p != f[2] && geo_.orient3d(f[0], f[2], f[1], p) == Sign::kPositive)
+          out.push_back(p);
+      return apexes.emplace(f, std::move(out)).first->second;
+    };
+    std::vector<std::array<Index, 4>> repl;
+    std::size_t nodes = 0;
+    std::function<bool()> search = [&]() -> bool {
+      if (front.empty()) return true;
+      if (++nodes > max_nodes) return false;
+      // The front face with the fewest apexes (none: a dead end).
+      const std::array<Index, 3>* best = nullptr;
+      std::size_t fewest = SIZE_MAX;
+      for (const auto& f : front) {
+        const std::size_t n = candidates(f).size();
+        if (n < fewest) fewest = n, best = &f;
+        if (n == 0) return false;
+      }
+      const std::array<Index, 3> f = *best;
+      const std::vector<Index> cs = candidates(f);
+      for (Index p : cs) {
+        const std::array<Index, 4> t{f[0], f[2], f[1], p};
+        // Fill t: the front loses t's faces that are on it and gains the reverse of the others.
+        const std::array<std::array<Index, 3>, 4> tf = {
+            {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+        std::vector<std::pair<bool, std::array<Index, 3>>> undo;  // (removed?, face)
+        bool fits = true;
+        for (const auto& g : tf) {
+          const auto k = canon(g), r = canon({g[0], g[2], g[1]});
+          if (front.count(k)) {
+            front.erase(k);
+            undo.push_back({true, k});
+          } else if (front.count(r)) {
+            fits = false;  // t would lie on the filled side of r
+            break;
+          } else {
+            front.insert(r);
+            undo.push_back({false, r});
+          }
+        }
+        if (fits) {
+          repl.push_back(t);
+          if (search()) return true;
+          repl.pop_back();
+        }
+        for (auto it = undo.rbegin(); it != undo.rend(); ++it)
+          if (it->first) front.insert(it->second);
+          else front.erase(it->second);
+        if (nodes > max_nodes) return false;
+      }
+      return false;
+    };
+    if (!search()) return false;
+    if (!tets_are_new(repl, cav)) return false;
+    std::int64_t gone = 0;
+    {
+      std::set<Index> before;
+      for (Index id : cav)
+        for (Index x : tets_[id])
+          if (!std::binary_search(verts.begin(), verts.end(), x)) before.insert(x);
+      gone = static_cast<std::int64_t>(before.size());
+    }
+    for (Index id : cav) kill_tet(id);
+    for (const auto& t : repl) add_tet(t);
+    merged += gone - 1;  // v itself counts as a collapse
+    return true;
+  }
   /// Removes the interior Steiner point v by re-coning a cavity from its neighbour u: the cavity
   /// starts as v's star and takes the tet beyond every face u does not see (never across a surface
   /// face), at most `max_grow` times and up to `max_tets` tets. The cone from u over the cavity's
@@ -1089,6 +1198,17 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
     for (std::size_t i = 0; i < k; ++i)
       if (mesh.cone_from_vertex(v, near[i].second, 24, 2000)) {
+        ++st.collapsed;
+        break;
+      }
+  }
+
+  // The last ones: re-tetrahedralize a grown cavity without them (up to five layers).
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    for (int layers = 0; layers <= 5; ++layers)
+      if (mesh.retetrahedralize(v, layers, 120, 5000)) {
         ++st.collapsed;
         break;
       }

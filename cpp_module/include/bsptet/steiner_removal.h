@@ -57,6 +57,29 @@
 //    and 2.3e-3) opened v's kernel to a clearance of 1.4e-5. So when RELOCATE fails, the interior
 //    Steiner neighbours of v are pushed and RELOCATE is tried once more.
 //
+//  * RETETRAHEDRALIZE a cavity without an interior Steiner point v: the cavity C is v's star grown
+//    by k layers (the tets across its boundary faces, k = 0..5, at most 120 tets); its boundary
+//    vertices B must include every vertex of C but interior Steiner points (those vanish). New
+//    tets over B are
+//    chosen by a depth-first search: the front starts as C's outward boundary faces; a step takes
+//    the front face f = (a, b, c) with the fewest apexes p in B that make t = (a, c, b, p)
+//    positive (exact), and fills t: each face of t that is on the front leaves it, the reverse of
+//    each other face joins it (t is refused if the reverse of one of its faces is on the front:
+//    that side is already filled). The search ends when the front is empty (or after a bounded
+//    number of steps: then nothing changes).
+//    Why the result tiles C: as oriented 2-chains the front is always dC minus the boundaries of
+//    the tets chosen, so an empty front means sum_t dt = dC. The winding number is linear in the
+//    chain and equals a tet's indicator (a.e.) for a positive tet, so sum_t 1_t = 1_C almost
+//    everywhere: the positive tets cover C and their interiors are disjoint. Their faces on dC are
+//    exactly C's boundary faces (what the front started with), so the tets outside C still meet
+//    them face to face; inside C every face is shared by two new tets (its two orientations
+//    cancelled on the front). A vertex of B cannot lie inside a new tet, face or edge: the tets at
+//    that vertex would overlap the ones around that simplex. Needed for box_with_hole (paper):
+//    its last interior Steiner point has no cone from any vertex and no edge removal; its star and
+//    the cavities 1 to 3 layers out have no fill over their boundary vertices (searched to the
+//    end), the cavity 4 layers out (24 of the 29 tets, 16 vertices) is re-filled with 19 tets: 24
+//    tets and no Steiner point in all, as tetgen -pY. Bounded work: 5000 search steps per cavity.
+//
 //  * ROUND an implicit interior point: the nearest doubles, else points pulled towards the centroid
 //    of its neighbours, taken only if every tet around it stays positive.
 //
@@ -64,8 +87,8 @@
 // remain (unless boundary Steiner points are allowed and are exactly doubles; a point that cannot
 // move gets its interior Steiner neighbours pushed and is tried again); collapse passes
 // again; merge interior points with their interior Steiner neighbours; cones from neighbours over
-// grown cavities; edge removals then collapses; cones from the 48 nearest vertices; round what is
-// left. Input points never move. Deterministic: vertices in id order,
+// grown cavities; edge removals then collapses; cones from the 48 nearest vertices; re-tetrahedralized
+// cavities; round what is left. Input points never move. Deterministic: vertices in id order,
 // neighbours input points first, then by id.
 #pragma once
 
