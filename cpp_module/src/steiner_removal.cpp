@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <unordered_map>
 
 #include "bsptet/errors.h"
 #include "bsptet/predicates.h"
@@ -184,19 +185,19 @@ class TetComplex {
 
   void grow() {
     const std::size_t nv = static_cast<std::size_t>(geo_.num_vertices());
-    if (vt_.size() < nv) vt_.resize(nv), vb_.resize(nv);
+    if (vt_.size() < nv) vt_.resize(nv), vb_.resize(nv), version_.resize(nv);
   }
   Index add_tet(const std::array<Index, 4>& t) {
     grow();
     const Index id = static_cast<Index>(tets_.size());
     tets_.push_back(t);
     talive_.push_back(1);
-    for (Index v : t) vt_[v].push_back(id);
+    for (Index v : t) vt_[v].push_back(id), ++version_[v];
     return id;
   }
   void kill_tet(Index id) {
     talive_[id] = 0;
-    for (Index v : tets_[id]) erase(vt_[v], id);
+    for (Index v : tets_[id]) erase(vt_[v], id), ++version_[v];
   }
   Index add_face(const std::array<Index, 3>& f, Index label) {
     grow();
@@ -204,14 +205,23 @@ class TetComplex {
     faces_.push_back(f);
     label_.push_back(label);
     falive_.push_back(1);
-    for (Index v : f) vb_[v].push_back(id);
+    for (Index v : f) vb_[v].push_back(id), ++version_[v];
     return id;
   }
   void kill_face(Index id) {
     falive_[id] = 0;
-    for (Index v : faces_[id]) erase(vb_[v], id);
+    for (Index v : faces_[id]) erase(vb_[v], id), ++version_[v];
   }
 
+  /// What a collapse of v depends on besides fixed geometry: its star and surface faces, and its
+  /// neighbours' surface faces (the support rule), as change counters (each tet or face added or
+  /// removed counts at its vertices). Counters only grow, and the neighbours are fixed while v's
+  /// counter is, so an equal signature means nothing a collapse attempt looks at has changed.
+  std::pair<std::uint64_t, std::uint64_t> signature(Index v, const std::vector<Index>& nbrs) const {
+    std::uint64_t sum = 0;
+    for (Index u : nbrs) sum += version_[u];
+    return {version_[v], sum};
+  }
   bool used(Index v) const { return v < static_cast<Index>(vt_.size()) && !vt_[v].empty(); }
   /// Input triangles containing the surface faces at v, sorted (empty: v is interior).
   std::vector<Index> labels(Index v) const {
@@ -399,15 +409,16 @@ class TetComplex {
       for (Index id : vt_[z]) cavity.push_back(id);
     std::sort(cavity.begin(), cavity.end());
     cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
-    auto cavity_bases = [&](const std::vector<Index>& cav) {
+    auto cavity_bases = [&](const std::vector<FacePair>& boundary) {
       // Outward faces of the cavity without a removed point, and the new surface triangles.
       std::vector<std::array<Index, 3>> out;
-      for (const auto& f : boundary_faces(cav))
+      for (const auto& [key, f] : boundary)
         if (!is_removed(f[0]) && !is_removed(f[1]) && !is_removed(f[2])) out.push_back(f);
       for (const auto& f : new_faces) out.push_back(f);
       return out;
     };
-    std::vector<std::array<Index, 3>> bases = cavity_bases(cavity);
+    const std::vector<FacePair> cavity_boundary = boundary_pairs(cavity);
+    std::vector<std::array<Index, 3>> bases = cavity_bases(cavity_boundary);
 
     // Candidate points w = v + eps * d, found in doubles, decided exactly below. Every cavity face
     // (v's link faces and the new surface triangles) is a half-space m . (w - a) > 0 (m unit). Faces
@@ -573,6 +584,7 @@ class TetComplex {
       // Cone from w; a face w does not see is removed from the cavity's boundary by taking the tet
       // beyond it into the cavity (never across the surface), a few times at most.
       std::vector<Index> cav = cavity;
+      std::vector<FacePair> boundary = cavity_boundary;
       std::vector<std::array<Index, 3>> bs = bases;
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
@@ -605,10 +617,12 @@ class TetComplex {
           add.push_back(beyond);
         }
         if (add.empty() || cav.size() + add.size() > max_cavity) break;
+        std::sort(add.begin(), add.end());
+        add.erase(std::unique(add.begin(), add.end()), add.end());
+        boundary = merge_boundaries(boundary, boundary_pairs(add));
         cav.insert(cav.end(), add.begin(), add.end());
         std::sort(cav.begin(), cav.end());
-        cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
-        bs = cavity_bases(cav);
+        bs = cavity_bases(boundary);
       }
       if (!ok) continue;
       for (Index id : cav) kill_tet(id);
@@ -781,12 +795,19 @@ class TetComplex {
     std::vector<Index> cav = vt_[v];
     std::sort(cav.begin(), cav.end());
     std::vector<std::array<Index, 4>> repl;
+    // v's star boundary, kept for the next call while v's star is unchanged (callers try one v
+    // with many u in a row).
+    if (star_boundary_of_ != v || star_boundary_version_ != version_[v]) {
+      star_boundary_ = boundary_pairs(cav);
+      star_boundary_of_ = v;
+      star_boundary_version_ = version_[v];
+    }
+    std::vector<FacePair> boundary = star_boundary_;
     for (int grow = 0; grow <= max_grow; ++grow) {
-      const std::vector<std::array<Index, 3>> bs = boundary_faces(cav);
       repl.clear();
       std::vector<Index> add;
       bool stop = false;
-      for (const auto& f : bs) {
+      for (const auto& [key, f] : boundary) {
         if (f[0] == u || f[1] == u || f[2] == u) continue;
         const std::array<Index, 4> t{f[0], f[2], f[1], u};
         if (geo_.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive) {
@@ -804,9 +825,11 @@ class TetComplex {
       if (stop) return false;
       if (add.empty()) break;
       if (cav.size() + add.size() > max_tets) return false;
+      std::sort(add.begin(), add.end());
+      add.erase(std::unique(add.begin(), add.end()), add.end());
+      boundary = merge_boundaries(boundary, boundary_pairs(add));
       cav.insert(cav.end(), add.begin(), add.end());
       std::sort(cav.begin(), cav.end());
-      cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
     }
     // Vertices that vanish (strictly inside the cavity) must be interior Steiner points.
     std::vector<Index> before, after;
@@ -898,10 +921,13 @@ class TetComplex {
     return true;
   }
 
-  /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
-  std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
-    std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
-    for (Index id : cav) {
+  /// (sorted vertex triple, outward face)
+  using FacePair = std::pair<std::array<Index, 3>, std::array<Index, 3>>;
+  /// The outward faces of a set of tets that appear once, in the order of their sorted triples.
+  std::vector<FacePair> boundary_pairs(const std::vector<Index>& ids) const {
+    std::vector<FacePair> all;
+    all.reserve(4 * ids.size());
+    for (Index id : ids) {
       const auto& t = tets_[id];
       const std::array<std::array<Index, 3>, 4> fs = {
           {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
@@ -912,13 +938,35 @@ class TetComplex {
       }
     }
     std::sort(all.begin(), all.end());
-    std::vector<std::array<Index, 3>> out;
+    std::vector<FacePair> out;
     for (std::size_t i = 0; i < all.size();) {
       std::size_t j = i + 1;
       while (j < all.size() && all[j].first == all[i].first) ++j;
-      if (j - i == 1) out.push_back(all[i].second);
+      if (j - i == 1) out.push_back(all[i]);
       i = j;
     }
+    return out;
+  }
+  /// The boundary of the union of two sets of tets without common tets, from their boundaries
+  /// (boundary_pairs order): the faces of one of them only (a face of both is now inside). A
+  /// cavity that grows by a few tets updates its boundary this way instead of sorting it again.
+  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b) {
+    std::vector<FacePair> out;
+    out.reserve(a.size() + b.size());
+    std::size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+      if (a[i].first < b[j].first) out.push_back(a[i++]);
+      else if (b[j].first < a[i].first) out.push_back(b[j++]);
+      else ++i, ++j;
+    }
+    out.insert(out.end(), a.begin() + static_cast<std::ptrdiff_t>(i), a.end());
+    out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(j), b.end());
+    return out;
+  }
+  /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
+  std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
+    std::vector<std::array<Index, 3>> out;
+    for (const auto& p : boundary_pairs(cav)) out.push_back(p.second);
     return out;
   }
   /// The tet across face f from the cavity `cav` (sorted), or -1 (a surface face).
@@ -979,6 +1027,10 @@ class TetComplex {
   std::vector<Index> label_;
   std::vector<char> falive_;
   std::vector<std::vector<Index>> vb_;
+  std::vector<std::uint64_t> version_;  ///< changes at each vertex (signature())
+  std::vector<FacePair> star_boundary_;  ///< cone_from_vertex: boundary of star_boundary_of_'s star
+  Index star_boundary_of_ = -1;
+  std::uint64_t star_boundary_version_ = 0;
 };
 
 }  // namespace
@@ -1011,6 +1063,9 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     st.steiner_before = static_cast<std::int64_t>(sv.size());
     for (Index v : sv) st.boundary_steiner_before += !mesh.labels(v).empty();
   }
+  // Collapse attempts that failed, with the signature they failed under: skipped until it changes
+  // (they would fail again; the collapses made are the same, only the repeated failures go).
+  std::unordered_map<Index, std::pair<std::uint64_t, std::uint64_t>> failed_collapse;
   auto collapse_passes = [&](double f0, double f1) {
     for (int pass = 0; pass < 50; ++pass) {
       bool changed = false;
@@ -1022,15 +1077,21 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           progress(f0 + (f1 - f0) * (pass + static_cast<double>(i) / sv.size()) / (pass + 2));
         }
         if (!mesh.used(v)) continue;
+        const std::vector<Index> nbrs = mesh.neighbours(v);
+        const auto sig = mesh.signature(v, nbrs);
+        const auto known = failed_collapse.find(v);
+        if (known != failed_collapse.end() && known->second == sig) continue;
         const std::vector<Index> lv = mesh.labels(v);
-        for (Index u : mesh.neighbours(v)) {
+        bool done = false;
+        for (Index u : nbrs) {
           if (!mesh.may_move_onto(v, lv, u)) continue;
           if (mesh.try_substitute(v, u)) {
             ++st.collapsed;
-            changed = true;
+            changed = done = true;
             break;
           }
         }
+        if (!done) failed_collapse[v] = sig;
       }
       if (!changed) break;
     }
