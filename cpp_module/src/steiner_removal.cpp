@@ -177,6 +177,23 @@ double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R
   return s;
 }
 
+// Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face: a
+// cavity that grows keeps most of its boundary faces, which need not be decided again.
+class SeesFace {
+ public:
+  SeesFace(ImplicitGeometry& geo, Index apex) : geo_(geo), apex_(apex) {}
+  bool operator()(const std::array<Index, 3>& f) {
+    auto it = known_.find(f);
+    if (it == known_.end()) it = known_.emplace(f, geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive).first;
+    return it->second;
+  }
+
+ private:
+  ImplicitGeometry& geo_;
+  Index apex_;
+  std::map<std::array<Index, 3>, bool> known_;
+};
+
 // The working tet complex: tets and boundary faces with vertex -> element lists.
 class TetComplex {
  public:
@@ -473,14 +490,22 @@ class TetComplex {
         Vec3 d;
         if (best_direction(near, &d) > 0) dirs.push_back(unit(d));
       }
+      // The 6 best-scoring directions with a positive score (score: min_m m . d), best first, ties
+      // in the order of dirs. There are O(|near|^2) directions: a score is abandoned as soon as it
+      // drops to the 6th best so far (or to 0), which cannot change the 6 kept.
       std::vector<std::pair<double, Vec3>> scored;
       for (const Vec3& d : dirs) {
+        const double bar = scored.size() < 6 ? 0.0 : std::max(0.0, scored.back().first);
         double score = INFINITY;
-        for (const Vec3& m : near) score = std::min(score, m.x * d.x + m.y * d.y + m.z * d.z);
-        if (score > 0) scored.push_back({score, d});
+        for (const Vec3& m : near) {
+          score = std::min(score, m.x * d.x + m.y * d.y + m.z * d.z);
+          if (score <= bar) break;
+        }
+        if (!(score > bar)) continue;
+        auto at = std::find_if(scored.begin(), scored.end(), [&](const auto& p) { return score > p.first; });
+        scored.insert(at, {score, d});
+        if (scored.size() > 6) scored.pop_back();
       }
-      std::stable_sort(scored.begin(), scored.end(), [](const auto& p, const auto& q) { return p.first > q.first; });
-      if (scored.size() > 6) scored.resize(6);
       for (const auto& [score, d] : scored) {
         double eps_max = lref;
         for (const auto& h : hs) {
@@ -589,13 +614,14 @@ class TetComplex {
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
+      SeesFace sees(geo_, wid);
       for (int grow = 0; grow <= max_grow; ++grow) {
         // Cone from w; every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
         std::vector<std::array<Index, 3>> bad;
         for (const auto& f : bs) {
           const std::array<Index, 4> t{f[0], f[2], f[1], wid};
-          if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) {
+          if (!sees(f)) {
             bad.push_back(f);
             if (grow == max_grow) break;  // no growth left: one bad face decides
           } else {
@@ -803,6 +829,7 @@ class TetComplex {
       star_boundary_version_ = version_[v];
     }
     std::vector<FacePair> boundary = star_boundary_;
+    SeesFace sees(geo_, u);
     for (int grow = 0; grow <= max_grow; ++grow) {
       repl.clear();
       std::vector<Index> add;
@@ -810,7 +837,7 @@ class TetComplex {
       for (const auto& [key, f] : boundary) {
         if (f[0] == u || f[1] == u || f[2] == u) continue;
         const std::array<Index, 4> t{f[0], f[2], f[1], u};
-        if (geo_.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive) {
+        if (sees(f)) {
           repl.push_back(t);
           continue;
         }
