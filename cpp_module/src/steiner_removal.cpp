@@ -647,7 +647,7 @@ class TetComplex {
         add.erase(std::unique(add.begin(), add.end()), add.end());
         boundary = merge_boundaries(boundary, boundary_pairs(add));
         cav.insert(cav.end(), add.begin(), add.end());
-        std::sort(cav.begin(), cav.end());
+        std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
         bs = cavity_bases(boundary);
       }
       if (!ok) continue;
@@ -856,7 +856,7 @@ class TetComplex {
       add.erase(std::unique(add.begin(), add.end()), add.end());
       boundary = merge_boundaries(boundary, boundary_pairs(add));
       cav.insert(cav.end(), add.begin(), add.end());
-      std::sort(cav.begin(), cav.end());
+      std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
     }
     // Vertices that vanish (strictly inside the cavity) must be interior Steiner points.
     std::vector<Index> before, after;
@@ -997,10 +997,16 @@ class TetComplex {
     return out;
   }
   /// The tet across face f from the cavity `cav` (sorted), or -1 (a surface face).
+  /// A face has at most two tets and one is in the cavity, so the answer does not depend on which
+  /// vertex's list is searched: the shortest one (input points can have thousands of tets).
   Index tet_beyond(const std::array<Index, 3>& f, const std::vector<Index>& cav) const {
-    for (Index id : vt_[f[0]]) {
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (vt_[f[i]].size() < vt_[f[k]].size()) k = i;
+    const Index a = f[(k + 1) % 3], b = f[(k + 2) % 3];
+    for (Index id : vt_[f[k]]) {
       const auto& t = tets_[id];
-      if (std::find(t.begin(), t.end(), f[1]) != t.end() && std::find(t.begin(), t.end(), f[2]) != t.end() &&
+      if (std::find(t.begin(), t.end(), a) != t.end() && std::find(t.begin(), t.end(), b) != t.end() &&
           !std::binary_search(cav.begin(), cav.end(), id))
         return id;
     }
