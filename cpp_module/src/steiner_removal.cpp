@@ -177,21 +177,33 @@ double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R
   return s;
 }
 
-// Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face: a
+// Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face (a
+// hash map: a tree map's lookups cost more than the predicates they saved) when `remember`: a
 // cavity that grows keeps most of its boundary faces, which need not be decided again.
 class SeesFace {
  public:
-  SeesFace(ImplicitGeometry& geo, Index apex) : geo_(geo), apex_(apex) {}
+  SeesFace(ImplicitGeometry& geo, Index apex, bool remember) : geo_(geo), apex_(apex), remember_(remember) {}
   bool operator()(const std::array<Index, 3>& f) {
+    if (!remember_) return decide(f);
     auto it = known_.find(f);
-    if (it == known_.end()) it = known_.emplace(f, geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive).first;
+    if (it == known_.end()) it = known_.emplace(f, decide(f)).first;
     return it->second;
   }
 
  private:
+  bool decide(const std::array<Index, 3>& f) { return geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive; }
+  struct Hash {
+    std::size_t operator()(const std::array<Index, 3>& f) const {
+      std::uint64_t h = static_cast<std::uint32_t>(f[0]);
+      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[1]);
+      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[2]);
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
   ImplicitGeometry& geo_;
   Index apex_;
-  std::map<std::array<Index, 3>, bool> known_;
+  bool remember_;
+  std::unordered_map<std::array<Index, 3>, bool, Hash> known_;
 };
 
 // The working tet complex: tets and boundary faces with vertex -> element lists.
@@ -614,7 +626,7 @@ class TetComplex {
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
-      SeesFace sees(geo_, wid);
+      SeesFace sees(geo_, wid, max_grow > 0);
       for (int grow = 0; grow <= max_grow; ++grow) {
         // Cone from w; every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
@@ -829,7 +841,7 @@ class TetComplex {
       star_boundary_version_ = version_[v];
     }
     std::vector<FacePair> boundary = star_boundary_;
-    SeesFace sees(geo_, u);
+    SeesFace sees(geo_, u, max_grow > 0);
     for (int grow = 0; grow <= max_grow; ++grow) {
       repl.clear();
       std::vector<Index> add;
