@@ -235,6 +235,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   st.boundary_steiner_before_removal = ss.boundary_steiner_before;
   st.collapsed = ss.collapsed;
   st.relocated = ss.relocated;
+  st.pushed = ss.pushed;
   st.apex_cells = cell_tets.apex_cells;
   st.pulled_cells = cell_tets.pulled_cells;
   st.bsp_nodes = 2 * bsp.stats().splits + 1;

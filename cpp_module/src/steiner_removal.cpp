@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <unordered_map>
 
 #include "bsptet/errors.h"
 #include "bsptet/predicates.h"
@@ -77,6 +78,134 @@ double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
   return best_s;
 }
 
+// The Chebyshev centre of a convex polytope {u : m_j . u >= d_j for all j} (m_j unit normals,
+// coordinates relative to some origin) clipped to the box |u_k| <= R: the point u that maximizes
+// its clearance s = min_j (m_j . u - d_j). Solved in doubles (a heuristic: every use is followed by
+// an exact check) as the dual LP, min sum b_j y_j subject to sum y_j A_j = (0, 0, 0, 1), y >= 0,
+// with primal rows A_j = (-m_j, 1), b_j = -d_j, by a two-phase tableau simplex with 4 rows; the
+// primal optimum (u, s) is the simplex multiplier vector of the optimal basis. Returns s (-inf when
+// the simplex fails).
+double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R, Vec3* out) {
+  std::vector<std::array<double, 4>> A;
+  std::vector<double> b;
+  for (const auto& [m, d] : hs) A.push_back({-m.x, -m.y, -m.z, 1.0}), b.push_back(-d);
+  for (int k = 0; k < 3; ++k)
+    for (double sg : {1.0, -1.0}) {
+      std::array<double, 4> row{0, 0, 0, 0};
+      row[k] = sg;
+      A.push_back(row), b.push_back(R);
+    }
+  A.push_back({0, 0, 0, 1}), b.push_back(R);
+  const std::size_t n = A.size(), cols = n + 4;  // y_j, then 4 artificials
+  std::vector<std::array<double, 4>> col(cols);  // tableau columns (B^-1 A_j)
+  for (std::size_t j = 0; j < n; ++j) col[j] = A[j];
+  for (int i = 0; i < 4; ++i) col[n + i] = {0, 0, 0, 0}, col[n + i][i] = 1.0;
+  std::array<double, 4> rhs{0, 0, 0, 1};
+  std::array<std::size_t, 4> basis{n, n + 1, n + 2, n + 3};
+  auto pivot = [&](int r, std::size_t e) {
+    const std::array<double, 4> pc = col[e];
+    const double p = pc[r];
+    for (auto& c : col) {
+      const double f = c[r] / p;
+      if (f == 0) continue;
+      for (int i = 0; i < 4; ++i) c[i] = i == r ? f : c[i] - f * pc[i];
+    }
+    const double f = rhs[r] / p;
+    for (int i = 0; i < 4; ++i) rhs[i] = i == r ? f : rhs[i] - f * pc[i];
+    basis[r] = e;
+  };
+  auto run = [&](const std::vector<double>& cost, bool allow_artificial) {
+    for (int iter = 0; iter < 500; ++iter) {
+      std::size_t enter = cols;
+      double best = -1e-12;
+      for (std::size_t j = 0; j < cols; ++j) {
+        if (!allow_artificial && j >= n) continue;
+        double red = cost[j];
+        for (int i = 0; i < 4; ++i) red -= cost[basis[i]] * col[j][i];
+        if (red < best) best = red, enter = j;
+      }
+      if (enter == cols) return true;
+      int leave = -1;
+      double ratio = INFINITY;
+      for (int i = 0; i < 4; ++i)
+        if (col[enter][i] > 1e-12 && rhs[i] / col[enter][i] < ratio) ratio = rhs[i] / col[enter][i], leave = i;
+      if (leave < 0) return false;  // unbounded dual: the polytope is empty
+      pivot(leave, enter);
+    }
+    return false;
+  };
+  std::vector<double> cost(cols, 0.0);
+  for (int i = 0; i < 4; ++i) cost[n + i] = 1.0;
+  if (!run(cost, true) || rhs[0] + rhs[1] + rhs[2] + rhs[3] > 1e-9) {
+    // artificial values left: infeasible dual (cannot happen with the box rows) or failure
+    double art = 0;
+    for (int i = 0; i < 4; ++i) art += basis[i] >= n ? rhs[i] : 0.0;
+    if (art > 1e-9) return -INFINITY;
+  }
+  for (int i = 0; i < 4; ++i)
+    if (basis[i] >= n) {
+      std::size_t e = cols;
+      for (std::size_t j = 0; j < n && e == cols; ++j)
+        if (std::fabs(col[j][i]) > 1e-9) e = j;
+      if (e == cols) return -INFINITY;
+      pivot(i, e);
+    }
+  for (std::size_t j = 0; j < n; ++j) cost[j] = b[j];
+  for (int i = 0; i < 4; ++i) cost[n + i] = 0.0;
+  if (!run(cost, false)) return -INFINITY;
+  // Multipliers: B^T pi = c_B (Gaussian elimination with partial pivoting).
+  double M[4][5];
+  for (int i = 0; i < 4; ++i) {
+    for (int k = 0; k < 4; ++k) M[i][k] = A[basis[i]][k];
+    M[i][4] = b[basis[i]];
+  }
+  for (int c = 0; c < 4; ++c) {
+    int piv = c;
+    for (int r = c + 1; r < 4; ++r)
+      if (std::fabs(M[r][c]) > std::fabs(M[piv][c])) piv = r;
+    if (M[piv][c] == 0) return -INFINITY;
+    for (int k = 0; k < 5; ++k) std::swap(M[c][k], M[piv][k]);
+    for (int r = 0; r < 4; ++r)
+      if (r != c) {
+        const double f = M[r][c] / M[c][c];
+        for (int k = c; k < 5; ++k) M[r][k] -= f * M[c][k];
+      }
+  }
+  *out = {M[0][4] / M[0][0], M[1][4] / M[1][1], M[2][4] / M[2][2]};
+  double s = INFINITY;  // the clearance actually reached (recomputed, not trusted from the LP)
+  for (const auto& [m, d] : hs) s = std::min(s, m.x * out->x + m.y * out->y + m.z * out->z - d);
+  return s;
+}
+
+// Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face (a
+// hash map: a tree map's lookups cost more than the predicates they saved) when `remember`: a
+// cavity that grows keeps most of its boundary faces, which need not be decided again.
+class SeesFace {
+ public:
+  SeesFace(ImplicitGeometry& geo, Index apex, bool remember) : geo_(geo), apex_(apex), remember_(remember) {}
+  bool operator()(const std::array<Index, 3>& f) {
+    if (!remember_) return decide(f);
+    auto it = known_.find(f);
+    if (it == known_.end()) it = known_.emplace(f, decide(f)).first;
+    return it->second;
+  }
+
+ private:
+  bool decide(const std::array<Index, 3>& f) { return geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive; }
+  struct Hash {
+    std::size_t operator()(const std::array<Index, 3>& f) const {
+      std::uint64_t h = static_cast<std::uint32_t>(f[0]);
+      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[1]);
+      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[2]);
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
+  ImplicitGeometry& geo_;
+  Index apex_;
+  bool remember_;
+  std::unordered_map<std::array<Index, 3>, bool, Hash> known_;
+};
+
 // The working tet complex: tets and boundary faces with vertex -> element lists.
 class TetComplex {
  public:
@@ -85,19 +214,19 @@ class TetComplex {
 
   void grow() {
     const std::size_t nv = static_cast<std::size_t>(geo_.num_vertices());
-    if (vt_.size() < nv) vt_.resize(nv), vb_.resize(nv);
+    if (vt_.size() < nv) vt_.resize(nv), vb_.resize(nv), version_.resize(nv);
   }
   Index add_tet(const std::array<Index, 4>& t) {
     grow();
     const Index id = static_cast<Index>(tets_.size());
     tets_.push_back(t);
     talive_.push_back(1);
-    for (Index v : t) vt_[v].push_back(id);
+    for (Index v : t) vt_[v].push_back(id), ++version_[v];
     return id;
   }
   void kill_tet(Index id) {
     talive_[id] = 0;
-    for (Index v : tets_[id]) erase(vt_[v], id);
+    for (Index v : tets_[id]) erase(vt_[v], id), ++version_[v];
   }
   Index add_face(const std::array<Index, 3>& f, Index label) {
     grow();
@@ -105,14 +234,23 @@ class TetComplex {
     faces_.push_back(f);
     label_.push_back(label);
     falive_.push_back(1);
-    for (Index v : f) vb_[v].push_back(id);
+    for (Index v : f) vb_[v].push_back(id), ++version_[v];
     return id;
   }
   void kill_face(Index id) {
     falive_[id] = 0;
-    for (Index v : faces_[id]) erase(vb_[v], id);
+    for (Index v : faces_[id]) erase(vb_[v], id), ++version_[v];
   }
 
+  /// What a collapse of v depends on besides fixed geometry: its star and surface faces, and its
+  /// neighbours' surface faces (the support rule), as change counters (each tet or face added or
+  /// removed counts at its vertices). Counters only grow, and the neighbours are fixed while v's
+  /// counter is, so an equal signature means nothing a collapse attempt looks at has changed.
+  std::pair<std::uint64_t, std::uint64_t> signature(Index v, const std::vector<Index>& nbrs) const {
+    std::uint64_t sum = 0;
+    for (Index u : nbrs) sum += version_[u];
+    return {version_[v], sum};
+  }
   bool used(Index v) const { return v < static_cast<Index>(vt_.size()) && !vt_[v].empty(); }
   /// Input triangles containing the surface faces at v, sorted (empty: v is interior).
   std::vector<Index> labels(Index v) const {
@@ -300,15 +438,16 @@ class TetComplex {
       for (Index id : vt_[z]) cavity.push_back(id);
     std::sort(cavity.begin(), cavity.end());
     cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
-    auto cavity_bases = [&](const std::vector<Index>& cav) {
+    auto cavity_bases = [&](const std::vector<FacePair>& boundary) {
       // Outward faces of the cavity without a removed point, and the new surface triangles.
       std::vector<std::array<Index, 3>> out;
-      for (const auto& f : boundary_faces(cav))
+      for (const auto& [key, f] : boundary)
         if (!is_removed(f[0]) && !is_removed(f[1]) && !is_removed(f[2])) out.push_back(f);
       for (const auto& f : new_faces) out.push_back(f);
       return out;
     };
-    std::vector<std::array<Index, 3>> bases = cavity_bases(cavity);
+    const std::vector<FacePair> cavity_boundary = boundary_pairs(cavity);
+    std::vector<std::array<Index, 3>> bases = cavity_bases(cavity_boundary);
 
     // Candidate points w = v + eps * d, found in doubles, decided exactly below. Every cavity face
     // (v's link faces and the new surface triangles) is a half-space m . (w - a) > 0 (m unit). Faces
@@ -363,14 +502,22 @@ class TetComplex {
         Vec3 d;
         if (best_direction(near, &d) > 0) dirs.push_back(unit(d));
       }
+      // The 6 best-scoring directions with a positive score (score: min_m m . d), best first, ties
+      // in the order of dirs. There are O(|near|^2) directions: a score is abandoned as soon as it
+      // drops to the 6th best so far (or to 0), which cannot change the 6 kept.
       std::vector<std::pair<double, Vec3>> scored;
       for (const Vec3& d : dirs) {
+        const double bar = scored.size() < 6 ? 0.0 : std::max(0.0, scored.back().first);
         double score = INFINITY;
-        for (const Vec3& m : near) score = std::min(score, m.x * d.x + m.y * d.y + m.z * d.z);
-        if (score > 0) scored.push_back({score, d});
+        for (const Vec3& m : near) {
+          score = std::min(score, m.x * d.x + m.y * d.y + m.z * d.z);
+          if (score <= bar) break;
+        }
+        if (!(score > bar)) continue;
+        auto at = std::find_if(scored.begin(), scored.end(), [&](const auto& p) { return score > p.first; });
+        scored.insert(at, {score, d});
+        if (scored.size() > 6) scored.pop_back();
       }
-      std::stable_sort(scored.begin(), scored.end(), [](const auto& p, const auto& q) { return p.first > q.first; });
-      if (scored.size() > 6) scored.resize(6);
       for (const auto& [score, d] : scored) {
         double eps_max = lref;
         for (const auto& h : hs) {
@@ -474,17 +621,19 @@ class TetComplex {
       // Cone from w; a face w does not see is removed from the cavity's boundary by taking the tet
       // beyond it into the cavity (never across the surface), a few times at most.
       std::vector<Index> cav = cavity;
+      std::vector<FacePair> boundary = cavity_boundary;
       std::vector<std::array<Index, 3>> bs = bases;
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
+      SeesFace sees(geo_, wid, max_grow > 0);
       for (int grow = 0; grow <= max_grow; ++grow) {
         // Cone from w; every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
         std::vector<std::array<Index, 3>> bad;
         for (const auto& f : bs) {
           const std::array<Index, 4> t{f[0], f[2], f[1], wid};
-          if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) {
+          if (!sees(f)) {
             bad.push_back(f);
             if (grow == max_grow) break;  // no growth left: one bad face decides
           } else {
@@ -506,10 +655,12 @@ class TetComplex {
           add.push_back(beyond);
         }
         if (add.empty() || cav.size() + add.size() > max_cavity) break;
+        std::sort(add.begin(), add.end());
+        add.erase(std::unique(add.begin(), add.end()), add.end());
+        boundary = merge_boundaries(boundary, boundary_pairs(add));
         cav.insert(cav.end(), add.begin(), add.end());
-        std::sort(cav.begin(), cav.end());
-        cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
-        bs = cavity_bases(cav);
+        std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
+        bs = cavity_bases(boundary);
       }
       if (!ok) continue;
       for (Index id : cav) kill_tet(id);
@@ -520,6 +671,156 @@ class TetComplex {
       return true;
     }
     return fail("no double-precision point just inside keeps its tets positive");
+  }
+  /// The half-spaces {u : m . u >= d} (m unit, u relative to `origin`) a point must be in to see
+  /// the outward faces `fs` of a cavity from inside (w makes (a, c, b, w) positive for face (a, b, c)).
+  std::vector<std::pair<Vec3, double>> seeing_half_spaces(const std::vector<std::array<Index, 3>>& fs,
+                                                          const Vec3& origin, double* size) {
+    std::vector<std::pair<Vec3, double>> hs;
+    *size = 0;
+    for (const auto& f : fs) {
+      const Vec3 a = geo_.rounded(f[0]), b = geo_.rounded(f[2]), c = geo_.rounded(f[1]);
+      const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, wx = c.x - a.x, wy = c.y - a.y, wz = c.z - a.z;
+      Vec3 m{uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx};
+      const double len = std::sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
+      if (!(len > 0)) continue;
+      m = {m.x / len, m.y / len, m.z / len};
+      hs.push_back({m, m.x * (a.x - origin.x) + m.y * (a.y - origin.y) + m.z * (a.z - origin.z)});
+      for (const Vec3& q : {a, b, c})
+        *size = std::max(*size, std::max({std::fabs(q.x - origin.x), std::fabs(q.y - origin.y), std::fabs(q.z - origin.z)}));
+    }
+    return hs;
+  }
+  /// PUSH (header comment): moves the interior Steiner point z to the Chebyshev centre of its
+  /// star's kernel (rounded to doubles) when that at least doubles its clearance from its link
+  /// faces (estimated in doubles); taken only if every new tet is positive (decided exactly).
+  bool push(Index z) {
+    if (z < np_ || !vb_[z].empty() || vt_[z].empty()) return false;
+    std::vector<Index> st = vt_[z];
+    std::sort(st.begin(), st.end());
+    std::vector<std::array<Index, 3>> link;
+    for (const auto& f : boundary_faces(st))
+      if (f[0] != z && f[1] != z && f[2] != z) link.push_back(f);
+    const Vec3 o = geo_.rounded(z);
+    double size = 0;
+    const auto hs = seeing_half_spaces(link, o, &size);
+    if (!(size > 0)) return false;
+    double now = INFINITY;
+    for (const auto& [m, d] : hs) now = std::min(now, -d);
+    Vec3 u;
+    const double s = chebyshev_centre(hs, size, &u);
+    if (!(s > 2 * std::max(now, 0.0)) || !(s > 0)) return false;
+    const Index w = geo_.add_explicit_point({o.x + u.x, o.y + u.y, o.z + u.z});
+    return try_substitute(z, w);
+  }
+  /// RETETRAHEDRALIZE (header comment): removes the interior Steiner point v by filling a cavity
+  /// around it (v's star grown by `layers` layers of tets that share a face's three vertices with
+  /// it) with new tets over the cavity's boundary vertices only, found by a depth-first search over
+  /// the front (the boundary chain of what is left to fill) with at most `max_nodes` steps.
+  bool retetrahedralize(Index v, int layers, std::size_t max_tets, std::size_t max_nodes) {
+    if (v < np_ || !vb_[v].empty() || vt_[v].empty()) return false;
+    std::vector<Index> cav = vt_[v];
+    std::sort(cav.begin(), cav.end());
+    for (int layer = 0; layer < layers; ++layer) {
+      std::vector<Index> add;
+      for (const auto& f : boundary_faces(cav)) {
+        const Index beyond = tet_beyond(f, cav);
+        if (beyond >= 0) add.push_back(beyond);
+      }
+      if (add.empty()) break;
+      cav.insert(cav.end(), add.begin(), add.end());
+      std::sort(cav.begin(), cav.end());
+      cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
+      if (cav.size() > max_tets) return false;
+    }
+    const std::vector<std::array<Index, 3>> bnd = boundary_faces(cav);
+    std::vector<Index> verts;
+    for (const auto& f : bnd)
+      for (Index x : f) verts.push_back(x);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    // Vertices inside the cavity vanish: they must be interior Steiner points (v among them).
+    for (Index id : cav)
+      for (Index x : tets_[id])
+        if (!std::binary_search(verts.begin(), verts.end(), x) && (x < np_ || !vb_[x].empty())) return false;
+    // Front faces are stored rotated so that the smallest id comes first (orientation kept).
+    auto canon = [](std::array<Index, 3> f) {
+      const int i = f[0] < f[1] ? (f[0] < f[2] ? 0 : 2) : (f[1] < f[2] ? 1 : 2);
+      return std::array<Index, 3>{f[i], f[(i + 1) % 3], f[(i + 2) % 3]};
+    };
+    std::set<std::array<Index, 3>> front;
+    for (const auto& f : bnd) front.insert(canon(f));
+    std::map<std::array<Index, 3>, std::vector<Index>> apexes;  // face -> vertices on its inner side
+    auto candidates = [&](const std::array<Index, 3>& f) -> const std::vector<Index>& {
+      auto it = apexes.find(f);
+      if (it != apexes.end()) return it->second;
+      std::vector<Index> out;
+      for (Index p : verts)
+        if (p != f[0] && p != f[1] && p != f[2] && geo_.orient3d(f[0], f[2], f[1], p) == Sign::kPositive)
+          out.push_back(p);
+      return apexes.emplace(f, std::move(out)).first->second;
+    };
+    std::vector<std::array<Index, 4>> repl;
+    std::size_t nodes = 0;
+    std::function<bool()> search = [&]() -> bool {
+      if (front.empty()) return true;
+      if (++nodes > max_nodes) return false;
+      // The front face with the fewest apexes (none: a dead end).
+      const std::array<Index, 3>* best = nullptr;
+      std::size_t fewest = SIZE_MAX;
+      for (const auto& f : front) {
+        const std::size_t n = candidates(f).size();
+        if (n < fewest) fewest = n, best = &f;
+        if (n == 0) return false;
+      }
+      const std::array<Index, 3> f = *best;
+      const std::vector<Index> cs = candidates(f);
+      for (Index p : cs) {
+        const std::array<Index, 4> t{f[0], f[2], f[1], p};
+        // Fill t: the front loses t's faces that are on it and gains the reverse of the others.
+        const std::array<std::array<Index, 3>, 4> tf = {
+            {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+        std::vector<std::pair<bool, std::array<Index, 3>>> undo;  // (removed?, face)
+        bool fits = true;
+        for (const auto& g : tf) {
+          const auto k = canon(g), r = canon({g[0], g[2], g[1]});
+          if (front.count(k)) {
+            front.erase(k);
+            undo.push_back({true, k});
+          } else if (front.count(r)) {
+            fits = false;  // t would lie on the filled side of r
+            break;
+          } else {
+            front.insert(r);
+            undo.push_back({false, r});
+          }
+        }
+        if (fits) {
+          repl.push_back(t);
+          if (search()) return true;
+          repl.pop_back();
+        }
+        for (auto it = undo.rbegin(); it != undo.rend(); ++it)
+          if (it->first) front.insert(it->second);
+          else front.erase(it->second);
+        if (nodes > max_nodes) return false;
+      }
+      return false;
+    };
+    if (!search()) return false;
+    if (!tets_are_new(repl, cav)) return false;
+    std::int64_t gone = 0;
+    {
+      std::set<Index> before;
+      for (Index id : cav)
+        for (Index x : tets_[id])
+          if (!std::binary_search(verts.begin(), verts.end(), x)) before.insert(x);
+      gone = static_cast<std::int64_t>(before.size());
+    }
+    for (Index id : cav) kill_tet(id);
+    for (const auto& t : repl) add_tet(t);
+    merged += gone - 1;  // v itself counts as a collapse
+    return true;
   }
   /// Removes the interior Steiner point v by re-coning a cavity from its neighbour u: the cavity
   /// starts as v's star and takes the tet beyond every face u does not see (never across a surface
@@ -532,15 +833,23 @@ class TetComplex {
     std::vector<Index> cav = vt_[v];
     std::sort(cav.begin(), cav.end());
     std::vector<std::array<Index, 4>> repl;
+    // v's star boundary, kept for the next call while v's star is unchanged (callers try one v
+    // with many u in a row).
+    if (star_boundary_of_ != v || star_boundary_version_ != version_[v]) {
+      star_boundary_ = boundary_pairs(cav);
+      star_boundary_of_ = v;
+      star_boundary_version_ = version_[v];
+    }
+    std::vector<FacePair> boundary = star_boundary_;
+    SeesFace sees(geo_, u, max_grow > 0);
     for (int grow = 0; grow <= max_grow; ++grow) {
-      const std::vector<std::array<Index, 3>> bs = boundary_faces(cav);
       repl.clear();
       std::vector<Index> add;
       bool stop = false;
-      for (const auto& f : bs) {
+      for (const auto& [key, f] : boundary) {
         if (f[0] == u || f[1] == u || f[2] == u) continue;
         const std::array<Index, 4> t{f[0], f[2], f[1], u};
-        if (geo_.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive) {
+        if (sees(f)) {
           repl.push_back(t);
           continue;
         }
@@ -555,9 +864,11 @@ class TetComplex {
       if (stop) return false;
       if (add.empty()) break;
       if (cav.size() + add.size() > max_tets) return false;
+      std::sort(add.begin(), add.end());
+      add.erase(std::unique(add.begin(), add.end()), add.end());
+      boundary = merge_boundaries(boundary, boundary_pairs(add));
       cav.insert(cav.end(), add.begin(), add.end());
-      std::sort(cav.begin(), cav.end());
-      cav.erase(std::unique(cav.begin(), cav.end()), cav.end());
+      std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
     }
     // Vertices that vanish (strictly inside the cavity) must be interior Steiner points.
     std::vector<Index> before, after;
@@ -649,10 +960,13 @@ class TetComplex {
     return true;
   }
 
-  /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
-  std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
-    std::vector<std::pair<std::array<Index, 3>, std::array<Index, 3>>> all;  // (sorted key, face)
-    for (Index id : cav) {
+  /// (sorted vertex triple, outward face)
+  using FacePair = std::pair<std::array<Index, 3>, std::array<Index, 3>>;
+  /// The outward faces of a set of tets that appear once, in the order of their sorted triples.
+  std::vector<FacePair> boundary_pairs(const std::vector<Index>& ids) const {
+    std::vector<FacePair> all;
+    all.reserve(4 * ids.size());
+    for (Index id : ids) {
       const auto& t = tets_[id];
       const std::array<std::array<Index, 3>, 4> fs = {
           {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
@@ -663,20 +977,48 @@ class TetComplex {
       }
     }
     std::sort(all.begin(), all.end());
-    std::vector<std::array<Index, 3>> out;
+    std::vector<FacePair> out;
     for (std::size_t i = 0; i < all.size();) {
       std::size_t j = i + 1;
       while (j < all.size() && all[j].first == all[i].first) ++j;
-      if (j - i == 1) out.push_back(all[i].second);
+      if (j - i == 1) out.push_back(all[i]);
       i = j;
     }
     return out;
   }
+  /// The boundary of the union of two sets of tets without common tets, from their boundaries
+  /// (boundary_pairs order): the faces of one of them only (a face of both is now inside). A
+  /// cavity that grows by a few tets updates its boundary this way instead of sorting it again.
+  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b) {
+    std::vector<FacePair> out;
+    out.reserve(a.size() + b.size());
+    std::size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+      if (a[i].first < b[j].first) out.push_back(a[i++]);
+      else if (b[j].first < a[i].first) out.push_back(b[j++]);
+      else ++i, ++j;
+    }
+    out.insert(out.end(), a.begin() + static_cast<std::ptrdiff_t>(i), a.end());
+    out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(j), b.end());
+    return out;
+  }
+  /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
+  std::vector<std::array<Index, 3>> boundary_faces(const std::vector<Index>& cav) const {
+    std::vector<std::array<Index, 3>> out;
+    for (const auto& p : boundary_pairs(cav)) out.push_back(p.second);
+    return out;
+  }
   /// The tet across face f from the cavity `cav` (sorted), or -1 (a surface face).
+  /// A face has at most two tets and one is in the cavity, so the answer does not depend on which
+  /// vertex's list is searched: the shortest one (input points can have thousands of tets).
   Index tet_beyond(const std::array<Index, 3>& f, const std::vector<Index>& cav) const {
-    for (Index id : vt_[f[0]]) {
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (vt_[f[i]].size() < vt_[f[k]].size()) k = i;
+    const Index a = f[(k + 1) % 3], b = f[(k + 2) % 3];
+    for (Index id : vt_[f[k]]) {
       const auto& t = tets_[id];
-      if (std::find(t.begin(), t.end(), f[1]) != t.end() && std::find(t.begin(), t.end(), f[2]) != t.end() &&
+      if (std::find(t.begin(), t.end(), a) != t.end() && std::find(t.begin(), t.end(), b) != t.end() &&
           !std::binary_search(cav.begin(), cav.end(), id))
         return id;
     }
@@ -730,6 +1072,10 @@ class TetComplex {
   std::vector<Index> label_;
   std::vector<char> falive_;
   std::vector<std::vector<Index>> vb_;
+  std::vector<std::uint64_t> version_;  ///< changes at each vertex (signature())
+  std::vector<FacePair> star_boundary_;  ///< cone_from_vertex: boundary of star_boundary_of_'s star
+  Index star_boundary_of_ = -1;
+  std::uint64_t star_boundary_version_ = 0;
 };
 
 }  // namespace
@@ -762,6 +1108,9 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     st.steiner_before = static_cast<std::int64_t>(sv.size());
     for (Index v : sv) st.boundary_steiner_before += !mesh.labels(v).empty();
   }
+  // Collapse attempts that failed, with the signature they failed under: skipped until it changes
+  // (they would fail again; the collapses made are the same, only the repeated failures go).
+  std::unordered_map<Index, std::pair<std::uint64_t, std::uint64_t>> failed_collapse;
   auto collapse_passes = [&](double f0, double f1) {
     for (int pass = 0; pass < 50; ++pass) {
       bool changed = false;
@@ -773,15 +1122,21 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           progress(f0 + (f1 - f0) * (pass + static_cast<double>(i) / sv.size()) / (pass + 2));
         }
         if (!mesh.used(v)) continue;
+        const std::vector<Index> nbrs = mesh.neighbours(v);
+        const auto sig = mesh.signature(v, nbrs);
+        const auto known = failed_collapse.find(v);
+        if (known != failed_collapse.end() && known->second == sig) continue;
         const std::vector<Index> lv = mesh.labels(v);
-        for (Index u : mesh.neighbours(v)) {
+        bool done = false;
+        for (Index u : nbrs) {
           if (!mesh.may_move_onto(v, lv, u)) continue;
           if (mesh.try_substitute(v, u)) {
             ++st.collapsed;
-            changed = true;
+            changed = done = true;
             break;
           }
         }
+        if (!done) failed_collapse[v] = sig;
       }
       if (!changed) break;
     }
@@ -837,6 +1192,14 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           }
           if (ok) break;
         }
+      }
+      if (!ok) {
+        // PUSH the interior Steiner points around v deeper (header comment), then try again: points
+        // left a few ulps from a surface plane through v close v's kernel.
+        bool pushed = false;
+        for (Index z : mesh.neighbours(v))
+          if (z >= np && mesh.labels(z).empty() && mesh.push(z)) pushed = true, ++st.pushed;
+        if (pushed) ok = mesh.relocate(v);
       }
       if (ok) {
         ++st.relocated;
@@ -941,6 +1304,17 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
     for (std::size_t i = 0; i < k; ++i)
       if (mesh.cone_from_vertex(v, near[i].second, 24, 2000)) {
+        ++st.collapsed;
+        break;
+      }
+  }
+
+  // The last ones: re-tetrahedralize a grown cavity without them (up to five layers).
+  for (Index v : steiner_vertices()) {
+    check_cancel();
+    if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
+    for (int layers = 0; layers <= 5; ++layers)
+      if (mesh.retetrahedralize(v, layers, 120, 5000)) {
         ++st.collapsed;
         break;
       }

@@ -46,11 +46,11 @@ int main(int argc, char** argv) {
     const TetMesh m = tetrahedralize(s, o, &st);
     const MeshCheckReport r = check_mesh(s, m);
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
-                "relocated %lld cells %lld inside %lld pulled %lld bsp_points %lld seconds %.3f min_dihedral %.2f\n",
+                "relocated %lld pushed %lld cells %lld inside %lld pulled %lld bsp_points %lld seconds %.3f min_dihedral %.2f\n",
                 argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
                 static_cast<long long>(st.boundary_steiner_before_removal), static_cast<long long>(st.collapsed),
-                static_cast<long long>(st.relocated), static_cast<long long>(st.convex_cells),
+                static_cast<long long>(st.relocated), static_cast<long long>(st.pushed), static_cast<long long>(st.convex_cells),
                 static_cast<long long>(st.inside_cells), static_cast<long long>(st.pulled_cells),
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg);
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace bsptet {
@@ -45,9 +47,18 @@ class Interval {
     if (lo == 0 && hi == 0) return Interval(0.0, 0.0);
     return widen_always(lo, hi);
   }
-  static Interval widen_always(double lo, double hi) {
-    return Interval(std::nextafter(lo, -std::numeric_limits<double>::infinity()),
-                    std::nextafter(hi, std::numeric_limits<double>::infinity()));
+  static Interval widen_always(double lo, double hi) { return Interval(-next_up(-lo), next_up(hi)); }
+  /// std::nextafter(x, +infinity), inline (the libm call was 14% of a run): the next double up.
+  /// Same result for every input: NaN stays NaN, +inf stays, -inf gives -max, +-0 gives the
+  /// smallest subnormal, and a negative x steps its magnitude down (-min subnormal gives -0).
+  static double next_up(double x) {
+    if (x != x || x == std::numeric_limits<double>::infinity()) return x;
+    if (x == 0) return std::numeric_limits<double>::denorm_min();
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = x > 0 ? bits + 1 : bits - 1;
+    std::memcpy(&x, &bits, sizeof bits);
+    return x;
   }
   double lo_ = 0, hi_ = 0;
 };

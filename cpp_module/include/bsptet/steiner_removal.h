@@ -37,14 +37,58 @@
 //    positive; the outer faces are kept, so the complex stays conforming. Used to lower the degree
 //    of an interior Steiner point until it collapses.
 //
+//  * PUSH an interior Steiner point z deeper: z is replaced by w, the Chebyshev centre of the kernel
+//    of its star (the point that maximizes the smallest distance to the planes of z's link faces,
+//    found by a 4-variable LP in doubles, then rounded), when every tet (f, w) over a link face f is
+//    positive (decided exactly). Valid by the COLLAPSE argument: the cones from w over the link
+//    tile the star when they are all positive (z has no surface faces, nothing else changes). It
+//    exists and helps: z sees its link strictly, so the kernel is an open convex set containing z
+//    and its Chebyshev radius is at least z's clearance; it is taken only when it at least doubles
+//    that clearance (estimated in doubles).
+//    Why it is needed (bottle.brep as the FreeCAD mesher tessellates it, surface Steiner point on
+//    the reflex cylinder edge 352-539, interior dihedral 193.8 deg): earlier relocations had left
+//    interior points 4.6e-10 inside input triangle 973 and 3e-11 beyond its plane's extension.
+//    A RELOCATE target w must see v's link faces and lie inside both input planes at v; a link
+//    face (a, b, z) with a, b on plane P through v and z at distance delta from P admits only
+//    points in a wedge of angle ~delta/|ab| between it and P, and two such faces on either side
+//    of P (here (352, 54630, 540) and (540, 32022, 539)) left a kernel of clearance <= 0 (LP:
+//    -2e-13 for v's star, and <= 0 for every union of v's star with its neighbours' stars, so no
+//    candidate and no cavity growth could succeed). Pushing the two points (to clearances 0.0998
+//    and 2.3e-3) opened v's kernel to a clearance of 1.4e-5. So when RELOCATE fails, the interior
+//    Steiner neighbours of v are pushed and RELOCATE is tried once more.
+//
+//  * RETETRAHEDRALIZE a cavity without an interior Steiner point v: the cavity C is v's star grown
+//    by k layers (the tets across its boundary faces, k = 0..5, at most 120 tets); its boundary
+//    vertices B must include every vertex of C but interior Steiner points (those vanish). New
+//    tets over B are
+//    chosen by a depth-first search: the front starts as C's outward boundary faces; a step takes
+//    the front face f = (a, b, c) with the fewest apexes p in B that make t = (a, c, b, p)
+//    positive (exact), and fills t: each face of t that is on the front leaves it, the reverse of
+//    each other face joins it (t is refused if the reverse of one of its faces is on the front:
+//    that side is already filled). The search ends when the front is empty (or after a bounded
+//    number of steps: then nothing changes).
+//    Why the result tiles C: as oriented 2-chains the front is always dC minus the boundaries of
+//    the tets chosen, so an empty front means sum_t dt = dC. The winding number is linear in the
+//    chain and equals a tet's indicator (a.e.) for a positive tet, so sum_t 1_t = 1_C almost
+//    everywhere: the positive tets cover C and their interiors are disjoint. Their faces on dC are
+//    exactly C's boundary faces (what the front started with), so the tets outside C still meet
+//    them face to face; inside C every face is shared by two new tets (its two orientations
+//    cancelled on the front). A vertex of B cannot lie inside a new tet, face or edge: the tets at
+//    that vertex would overlap the ones around that simplex. Needed for box_with_hole (paper):
+//    its last interior Steiner point has no cone from any vertex and no edge removal; its star and
+//    the cavities 1 to 3 layers out have no fill over their boundary vertices (searched to the
+//    end), the cavity 4 layers out (24 of the 29 tets, 16 vertices) is re-filled with 19 tets: 24
+//    tets and no Steiner point in all, as tetgen -pY. Bounded work: 5000 search steps per cavity.
+//
 //  * ROUND an implicit interior point: the nearest doubles, else points pulled towards the centroid
 //    of its neighbours, taken only if every tet around it stays positive.
 //
 // Order: collapse passes over all Steiner points until none applies; relocate the surface ones that
-// remain (unless boundary Steiner points are allowed and are exactly doubles); collapse passes
+// remain (unless boundary Steiner points are allowed and are exactly doubles; a point that cannot
+// move gets its interior Steiner neighbours pushed and is tried again); collapse passes
 // again; merge interior points with their interior Steiner neighbours; cones from neighbours over
-// grown cavities; edge removals then collapses; cones from the 48 nearest vertices; round what is
-// left. Input points never move. Deterministic: vertices in id order,
+// grown cavities; edge removals then collapses; cones from the 48 nearest vertices; re-tetrahedralized
+// cavities; round what is left. Input points never move. Deterministic: vertices in id order,
 // neighbours input points first, then by id.
 #pragma once
 
@@ -67,7 +111,7 @@ struct SteinerRemovalOptions {
 
 struct SteinerRemovalStats {
   std::int64_t steiner_before = 0, boundary_steiner_before = 0;
-  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0;
+  std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0, pushed = 0;
   std::int64_t boundary_steiner_after = 0;
 };
 
