@@ -380,13 +380,16 @@ class Refiner {
       if (std::isfinite(t) ? l < o_.collapse_ratio * t : false) todo.emplace_back(l / t, e[0], e[1]);
     }
     std::sort(todo.begin(), todo.end());
+    // New tets stay at or above min(max(collapse_min_dihedral_deg, the mesh's worst tet), the
+    // worst tet around the point): the mesh's worst dihedral angle never drops.
+    const double floor = std::max(o_.collapse_min_dihedral_deg, worst_quality());
     std::int64_t n = 0;
     for (const auto& [r, u, v] : todo) {
       if (!m_.point_alive(u) || !m_.point_alive(v)) continue;
       for (const auto& [from, to] : {std::pair<Index, Index>{u, v}, std::pair<Index, Index>{v, u}}) {
         if (m_.support(from).kind == Support::kInputVertex) continue;
         const double lim = o_.split_ratio * target(to);
-        if (m_.collapse_edge(from, to, o_.collapse_min_dihedral_deg, std::isfinite(lim) ? lim * lim : kInf)) {
+        if (m_.collapse_edge(from, to, floor, std::isfinite(lim) ? lim * lim : kInf)) {
           ++n;
           break;
         }

@@ -58,8 +58,10 @@ struct RefineOptions {
   /// making an edge longer than split_ratio * target, and see collapse_min_dihedral_deg).
   double collapse_ratio = 0.8;
   /// A collapse is applied when its new tets' smallest dihedral angle is at least
-  /// min(collapse_min_dihedral_deg, the worst tet's around the point before); degrees. 180: a
-  /// collapse never makes the worst tet around worse (many short edges then stay).
+  /// min(max(collapse_min_dihedral_deg, the mesh's worst), the worst tet's around the point
+  /// before); degrees. So collapses never lower the mesh's worst angle, and may lower a local
+  /// worst down to this bound. 180: a collapse never makes the worst tet around worse (many
+  /// short edges then stay).
   double collapse_min_dihedral_deg = 10;
   /// Tets whose circumradius / shortest edge exceeds this are refined (0: no bound). TetGen's -q
   /// default is 2.0; 1.414 is stricter.
