@@ -72,6 +72,18 @@ TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
   return m;
 }
 
+// A mesh's points as an (n, 3) float array and its tets as an (m, nodes_per_tet) int64 array.
+py::array_t<double> points_array(const TetMesh& m) {
+  py::array_t<double> a({static_cast<py::ssize_t>(m.num_points()), static_cast<py::ssize_t>(3)});
+  std::copy(m.xyz.begin(), m.xyz.end(), a.mutable_data());
+  return a;
+}
+py::array_t<std::int64_t> tets_array(const TetMesh& m) {
+  py::array_t<std::int64_t> a({static_cast<py::ssize_t>(m.num_tets()), static_cast<py::ssize_t>(m.nodes_per_tet)});
+  std::copy(m.tet.begin(), m.tet.end(), a.mutable_data());
+  return a;
+}
+
 // Runs `run` (a call of the core) without the GIL, with the options' `cancelled` and `progress`
 // callbacks wired to Python (they take the GIL for each call). Ctrl-C (a pending SIGINT) cancels
 // the run and raises KeyboardInterrupt; `cancel()` returning True cancels it with the core's
@@ -143,10 +155,6 @@ PYBIND11_MODULE(_bsptet, m) {
         TetMesh mesh;
         MeshStats st;
         run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
-        py::array_t<double> xyz({static_cast<py::ssize_t>(mesh.num_points()), static_cast<py::ssize_t>(3)});
-        std::copy(mesh.xyz.begin(), mesh.xyz.end(), xyz.mutable_data());
-        py::array_t<std::int64_t> tets({static_cast<py::ssize_t>(mesh.num_tets()), static_cast<py::ssize_t>(4)});
-        std::copy(mesh.tet.begin(), mesh.tet.end(), tets.mutable_data());
         py::dict d;
         d["input_points"] = st.input_points;
         d["input_triangles"] = st.input_triangles;
@@ -167,7 +175,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["exact_fallbacks"] = st.exact_fallbacks;
         d["seconds_by_stage"] = st.seconds_by_stage;
         d["seconds_core"] = st.seconds_total;
-        return py::make_tuple(xyz, tets, d);
+        return py::make_tuple(points_array(mesh), tets_array(mesh), d);
       },
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
@@ -260,11 +268,6 @@ PYBIND11_MODULE(_bsptet, m) {
         TetMesh out;
         RefineStats st;
         run_without_gil(o, progress, cancel, [&]() { out = refine_quality(s, mesh, o, &st); });
-        const py::ssize_t npt = out.nodes_per_tet;
-        py::array_t<double> xyz({static_cast<py::ssize_t>(out.num_points()), static_cast<py::ssize_t>(3)});
-        std::copy(out.xyz.begin(), out.xyz.end(), xyz.mutable_data());
-        py::array_t<std::int64_t> t({static_cast<py::ssize_t>(out.num_tets()), npt});
-        std::copy(out.tet.begin(), out.tet.end(), t.mutable_data());
         py::dict d;
         d["points"] = st.points;
         d["tets"] = st.tets;
@@ -286,7 +289,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["midnodes_projected"] = st.midnodes_projected;
         d["midnodes_straightened"] = st.midnodes_straightened;
         d["seconds"] = st.seconds;
-        return py::make_tuple(xyz, t, d);
+        return py::make_tuple(points_array(out), tets_array(out), d);
       },
       py::arg("surface_points"), py::arg("surface_triangles"), py::arg("surface_tags"), py::arg("points"),
       py::arg("tets"), py::arg("size") = std::numeric_limits<double>::infinity(), py::arg("min_size") = 0.0,
