@@ -74,6 +74,7 @@ class NotImplementedYetError(InternalError):
     """A feature that is planned but not built yet. Says which, never pretends."""
 
 
-class MeshingCancelled(InternalError):
-    """The user stopped a meshing run (Cancel in the task panel, ``cancel()`` returning True).
-    No mesh was made; an object's previous mesh is kept."""
+class MeshingCancelled(Cancelled):
+    """The user stopped a FreeCAD meshing run (Cancel in the task panel, ``cancel()`` returning
+    True). No mesh was made; an object's previous mesh is kept. A :class:`Cancelled` like the
+    core's own cancellation, so ``except Cancelled`` catches both."""

@@ -55,7 +55,7 @@ def worker_env():
 
 
 _ERROR_TYPES = {"InputError": InputError, "InternalError": InternalError,
-                "MeshingCancelled": MeshingCancelled}
+                "MeshingCancelled": MeshingCancelled, "Cancelled": MeshingCancelled}
 
 
 def write_job(job_dir, shape, params, source=""):
