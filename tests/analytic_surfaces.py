@@ -95,3 +95,26 @@ def cylinder_distance(points, radius, height):
     bottom = np.where(r <= radius, np.abs(z), np.inf)
     top = np.where(r <= radius, np.abs(z - height), np.inf)
     return np.minimum(side, np.minimum(bottom, top))
+
+
+def lat_long_sphere(n_lat, n_lon):
+    """The unit sphere as a latitude/longitude triangulation: poles 0 and the last point, n_lat - 1
+    rings of n_lon points; closed and outward. Returns (points (n, 3), triangles (m, 3))."""
+    pts = [(0.0, 0.0, 1.0)]
+    for i in range(1, n_lat):
+        th = np.pi * i / n_lat
+        for j in range(n_lon):
+            ph = 2 * np.pi * j / n_lon
+            pts.append((np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)))
+    pts.append((0.0, 0.0, -1.0))
+    ring = lambda i, j: 1 + (i - 1) * n_lon + (j % n_lon)  # noqa: E731
+    south = len(pts) - 1
+    tris = []
+    for j in range(n_lon):
+        tris.append((0, ring(1, j), ring(1, j + 1)))
+        tris.append((south, ring(n_lat - 1, j + 1), ring(n_lat - 1, j)))
+    for i in range(1, n_lat - 1):
+        for j in range(n_lon):
+            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
+            tris += [(a, c, b), (b, c, d)]
+    return np.array(pts), np.array(tris)

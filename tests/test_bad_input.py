@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import pytest
+from analytic_surfaces import lat_long_sphere
 from conftest import DATA, corpus_path, paper_path
 
 from FemBspTet.freecad_env import freecad_available
@@ -128,24 +129,7 @@ def cad_garbage(tmp):
 def big_surface(tmp):
     """A closed surface of 20000 triangles: a latitude/longitude sphere."""
     path = tmp / "big.off"
-    lat, lon = 101, 100
-    tris = []
-    pts = [(0.0, 0.0, 1.0)]
-    for i in range(1, lat):
-        th = np.pi * i / lat
-        for j in range(lon):
-            ph = 2 * np.pi * j / lon
-            pts.append((np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)))
-    pts.append((0.0, 0.0, -1.0))
-    ring = lambda i, j: 1 + (i - 1) * lon + (j % lon)  # noqa: E731
-    south = len(pts) - 1
-    for j in range(lon):
-        tris.append((0, ring(1, j), ring(1, j + 1)))
-        tris.append((south, ring(lat - 1, j + 1), ring(lat - 1, j)))
-    for i in range(1, lat - 1):
-        for j in range(lon):
-            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
-            tris += [(a, c, b), (b, c, d)]
+    pts, tris = lat_long_sphere(101, 100)
     path.write_text(off_text(pts, tris))
     return path
 

@@ -4,6 +4,7 @@ Steiner point on the surface). Seeds are fixed and printed, so a failure can be 
 
 import numpy as np
 import pytest
+from analytic_surfaces import lat_long_sphere
 from conftest import PAPER_MODELS, paper_path
 
 from FemBspTet import core
@@ -56,25 +57,9 @@ def test_near_degenerate_perturbations(model, seed):
 
 def star_shaped(rng, n_lat, n_lon):
     """A radial graph over a latitude/longitude sphere triangulation: closed, outward, simple."""
-    pts = [(0.0, 0.0, 1.0)]
-    for i in range(1, n_lat):
-        th = np.pi * i / n_lat
-        for j in range(n_lon):
-            ph = 2 * np.pi * j / n_lon
-            pts.append((np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)))
-    pts.append((0.0, 0.0, -1.0))
-    pts = np.array(pts) * rng.uniform(0.4, 1.6, size=(len(pts), 1))
-    tris = []
-    ring = lambda i, j: 1 + (i - 1) * n_lon + (j % n_lon)  # noqa: E731
-    south = len(pts) - 1
-    for j in range(n_lon):
-        tris.append((0, ring(1, j), ring(1, j + 1)))
-        tris.append((south, ring(n_lat - 1, j + 1), ring(n_lat - 1, j)))
-    for i in range(1, n_lat - 1):
-        for j in range(n_lon):
-            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
-            tris += [(a, c, b), (b, c, d)]
-    return Surface(pts, np.array(tris))
+    pts, tris = lat_long_sphere(n_lat, n_lon)
+    pts = pts * rng.uniform(0.4, 1.6, size=(len(pts), 1))
+    return Surface(pts, tris)
 
 
 @pytest.mark.parametrize("seed", range(31, 39))
