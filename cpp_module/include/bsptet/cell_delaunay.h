@@ -1,0 +1,63 @@
+// FemBspTet core: the paper's per-cell Delaunay tetrahedralization (Sec. 2.3), exact, and the face
+// triangulations that make the cells' tets conform.
+//
+// One global rule decides every tie: the perturbed lifting of ImplicitGeometry::lifted_det3/2,
+// H(v) = |v|^2 + eps^k(v) with k strictly decreasing in the global vertex id. Under it, every
+// finite point set has exactly one regular ("perturbed Delaunay") triangulation, in 2D and in 3D,
+// using every point as a vertex (the lifted points are in strictly convex position: a strictly
+// convex paraboloid, perturbed infinitesimally).
+//
+// Why both cells of a shared face triangulate it identically (the argument, also for cocircular
+// points and for T-junction vertices collinear on a face's edges):
+//  1. delaunay_face() gives the perturbed 2D regular triangulation of the face's own vertices (in
+//     the face's plane, lifted by the same H). It depends only on those vertices and their ids,
+//     so it is the same whichever cell asks; it is computed once per face anyway.
+//  2. For a cell, the hull triangles of the 3D perturbed regular triangulation on one facet plane
+//     F of the cell are the 2D perturbed regular triangulation of the cell's points on F with the
+//     same heights (the lower faces of the lifted hull above the face F of the convex hull are the
+//     lower faces of the lifted points above F; an affine parameterization of F's plane keeps
+//     "below"). When F carries one BSP face, that is exactly the face's triangulation of 1.
+//  3. When F carries several BSP faces (a neighbour was split, this cell was not), the 3D hull may
+//     cross their common edges. So the caller compares, per cell, the hull triangles with the union
+//     of its faces' triangulations (1.), as oriented triangles. Only an exact match is accepted;
+//     the tets then meet every neighbour on the shared face's one triangulation. A mismatch sends
+//     the cell to the cone fillers (cell_tetrahedralize.h), which use the same face triangulations.
+// Validity of the tets: the Delaunay triangulation of the cell's vertices tiles their convex hull,
+// which is the (convex) cell; Bowyer-Watson never makes a flat tet under the perturbation (a
+// coplanar point on a hull face is in conflict with the outside of that face exactly when it is
+// in conflict with the tet inside, since the circumsphere meets the plane in the circumcircle);
+// and every output tet is also re-checked to be strictly positive (exact orient3d), else the cell
+// falls back as in 3. No epsilon anywhere: every decision is an exact sign.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "bsptet/bsp_complex.h"
+#include "bsptet/implicit_geometry.h"
+
+namespace bsptet {
+
+/// The perturbed 2D Delaunay (regular) triangulation of convex face `face` (all its vertices, also
+/// collinear ones), counter-clockwise around the plane normal: ear clipping, then Lawson flips
+/// under lifted_det2. Throws MeshingError (kInternal) if the face is degenerate.
+std::vector<std::array<Index, 3>> delaunay_face(ImplicitGeometry& geo, const BspFace& face);
+
+struct CellDelaunay {
+  std::vector<std::array<Index, 4>> tets;  ///< positively oriented (exact), global vertex ids
+  std::vector<std::array<Index, 3>> hull;  ///< boundary triangles, counter-clockwise seen from outside
+};
+
+/// Randomized incremental Bowyer-Watson of `points` (distinct global vertex ids, not all coplanar),
+/// with ghost tets for the outside: the perturbed Delaunay tetrahedralization of the points.
+/// `seed` fixes the insertion order (a local generator: no global state; the result itself does
+/// not depend on the order, the perturbed triangulation being unique). Returns false (output
+/// unspecified) if an internal consistency check fails (a non-manifold cavity, a walk that does
+/// not end, a non-positive tet): the caller then uses another filler.
+/// `planes`: planes known to carry points of the set (the cell's face planes; may be empty): with
+/// ImplicitGeometry::known_on_plane they decide coplanar cases without arithmetic (speed only).
+bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::vector<Index>& planes,
+                   std::uint64_t seed, CellDelaunay& out);
+
+}  // namespace bsptet
