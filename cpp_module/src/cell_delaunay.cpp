@@ -365,4 +365,129 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
   return bw.collect(out);
 }
 
+namespace {
+
+using Tri = std::array<Index, 3>;
+
+Tri canonical_tri(Tri t) {
+  std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+  return t;
+}
+Tri reversed(const Tri& t) { return canonical_tri({t[0], t[2], t[1]}); }
+
+// Outward faces of tet t, canonical.
+std::array<Tri, 4> outward_faces(const std::array<Index, 4>& t) {
+  std::array<Tri, 4> f;
+  for (int i = 0; i < 4; ++i) f[i] = canonical_tri({t[kFace[i][0]], t[kFace[i][2]], t[kFace[i][1]]});
+  return f;
+}
+
+// The boundary of a set of tets (outward, canonical, sorted); interior pairs cancel.
+std::vector<Tri> chain_boundary(const std::vector<std::array<Index, 4>>& tets, const std::vector<std::size_t>& ids) {
+  std::vector<Tri> all;
+  for (std::size_t i : ids)
+    for (const Tri& f : outward_faces(tets[i])) all.push_back(f);
+  std::sort(all.begin(), all.end());
+  std::vector<Tri> out;
+  for (const Tri& f : all)
+    if (!std::binary_search(all.begin(), all.end(), reversed(f))) out.push_back(f);
+  return out;
+}
+
+}  // namespace
+
+bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,
+                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_layers) {
+  std::vector<Index> planes;
+  for (const auto& w : want) planes.push_back(w.second);
+  std::sort(planes.begin(), planes.end());
+  planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+  std::vector<Tri> want_all;
+  for (const auto& w : want) want_all.push_back(canonical_tri(w.first));
+  std::sort(want_all.begin(), want_all.end());
+  auto on_plane = [&](const Tri& t, Index p) {
+    return geo.known_on_plane(t[0], p) && geo.known_on_plane(t[1], p) && geo.known_on_plane(t[2], p);
+  };
+  for (Index p : planes) {
+    std::vector<std::size_t> ids_all(tets.size());
+    for (std::size_t i = 0; i < tets.size(); ++i) ids_all[i] = i;
+    const std::vector<Tri> hull = chain_boundary(tets, ids_all);
+    std::vector<Tri> have_p, want_p;
+    for (const Tri& t : hull)
+      if (on_plane(t, p)) have_p.push_back(t);
+    for (const auto& w : want)
+      if (w.second == p) want_p.push_back(canonical_tri(w.first));
+    std::sort(want_p.begin(), want_p.end());
+    if (have_p == want_p) continue;
+    // Cavity: the tets with a face among have_p.
+    std::vector<char> in(tets.size(), 0);
+    for (std::size_t i = 0; i < tets.size(); ++i)
+      for (const Tri& f : outward_faces(tets[i]))
+        if (std::binary_search(have_p.begin(), have_p.end(), f)) in[i] = 1;
+    bool done = false;
+    for (int layer = 0; layer <= max_layers && !done; ++layer) {
+      std::vector<std::size_t> ids;
+      for (std::size_t i = 0; i < tets.size(); ++i)
+        if (in[i]) ids.push_back(i);
+      std::vector<Tri> bnd;
+      for (const Tri& f : chain_boundary(tets, ids))
+        if (!std::binary_search(have_p.begin(), have_p.end(), f)) bnd.push_back(f);
+      const std::size_t outer = bnd.size();  // faces [0, outer) are not on P
+      bnd.insert(bnd.end(), want_p.begin(), want_p.end());
+      // Faces of the cavity boundary on the cell boundary (the cavity does not grow across them).
+      std::vector<char> on_cell(bnd.size(), 0);
+      for (std::size_t k = 0; k < bnd.size(); ++k)
+        on_cell[k] = k >= outer || std::binary_search(hull.begin(), hull.end(), bnd[k]);
+      std::vector<Index> cand;
+      for (const Tri& f : bnd)
+        for (Index v : f) cand.push_back(v);
+      std::sort(cand.begin(), cand.end());
+      cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+      std::vector<std::array<Index, 4>> fill;
+      for (Index v : cand) {
+        fill.clear();
+        bool ok = true;
+        for (std::size_t k = 0; k < bnd.size() && ok; ++k) {
+          const Tri& f = bnd[k];
+          if (f[0] == v || f[1] == v || f[2] == v) continue;  // a flat cone; the face stays (chain argument)
+          const std::array<Index, 4> t{{f[0], f[2], f[1], v}};
+          if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) ok = false;
+          fill.push_back(t);
+        }
+        if (!ok) continue;
+        std::vector<std::array<Index, 4>> next;
+        for (std::size_t i = 0; i < tets.size(); ++i)
+          if (!in[i]) next.push_back(tets[i]);
+        next.insert(next.end(), fill.begin(), fill.end());
+        tets.swap(next);
+        done = true;
+        break;
+      }
+      if (done) break;
+      // Grow by the face neighbours of the cavity (across faces not on the cell boundary).
+      std::vector<Tri> grow;
+      for (std::size_t k = 0; k < outer; ++k)
+        if (!on_cell[k]) grow.push_back(reversed(bnd[k]));
+      std::sort(grow.begin(), grow.end());
+      bool grew = false;
+      for (std::size_t i = 0; i < tets.size(); ++i) {
+        if (in[i]) continue;
+        for (const Tri& f : outward_faces(tets[i]))
+          if (std::binary_search(grow.begin(), grow.end(), f)) {
+            in[i] = 1;
+            grew = true;
+            break;
+          }
+      }
+      if (!grew) break;
+    }
+    if (!done) return false;
+  }
+  std::vector<std::size_t> ids_all(tets.size());
+  for (std::size_t i = 0; i < tets.size(); ++i) ids_all[i] = i;
+  for (const auto& t : tets)
+    if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
+  return chain_boundary(tets, ids_all) == want_all;
+}
+
 }  // namespace bsptet

@@ -337,6 +337,7 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
   CellDelaunay dt;
   std::vector<std::array<Index, 3>> want;
   std::vector<Index> cell_planes;
+  std::vector<std::pair<std::array<Index, 3>, Index>> want_planes;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (!cells[c].alive || labels.winding[c] != 1) continue;
     ++out.inside_cells;
@@ -364,6 +365,19 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
       std::sort(dt.hull.begin(), dt.hull.end());
       if (dt.hull == want) {
         ++out.delaunay_cells;
+        out.tets.insert(out.tets.end(), dt.tets.begin(), dt.tets.end());
+        continue;
+      }
+      // Some facet made of several faces: recover the faces' triangulations.
+      want_planes.clear();
+      for (Index f : cells[c].faces) {
+        const bool positive_side = faces[f].cell[0] == ci;
+        for (const auto& t : tris_of(f))
+          want_planes.push_back({positive_side ? std::array<Index, 3>{t[0], t[2], t[1]} : t, faces[f].plane});
+      }
+      if (recover_cell_boundary(geo, dt.tets, want_planes, 3)) {
+        ++out.delaunay_cells;
+        ++out.recovered_cells;
         out.tets.insert(out.tets.end(), dt.tets.begin(), dt.tets.end());
         continue;
       }

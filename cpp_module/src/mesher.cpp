@@ -239,6 +239,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   st.apex_cells = cell_tets.apex_cells;
   st.pulled_cells = cell_tets.pulled_cells;
   st.delaunay_cells = cell_tets.delaunay_cells;
+  st.delaunay_recovered_cells = cell_tets.recovered_cells;
   st.delaunay_fallback_cells = cell_tets.delaunay_fallback_cells;
   st.bsp_nodes = 2 * bsp.stats().splits + 1;
   st.convex_cells = bsp.stats().leaves;

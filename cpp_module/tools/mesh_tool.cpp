@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     const TetMesh m = tetrahedralize(s, o, &st);
     const MeshCheckReport r = check_mesh(s, m);
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
-                "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld fallback %lld bsp_points %lld seconds %.3f "
+                "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld (recovered %lld) fallback %lld bsp_points %lld seconds %.3f "
                 "min_dihedral %.2f\n",
                 argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.relocated), static_cast<long long>(st.pushed), static_cast<long long>(st.convex_cells),
                 static_cast<long long>(st.inside_cells), static_cast<long long>(st.pulled_cells),
                 static_cast<long long>(st.apex_cells), static_cast<long long>(st.delaunay_cells),
+                static_cast<long long>(st.delaunay_recovered_cells),
                 static_cast<long long>(st.delaunay_fallback_cells),
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg);
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);

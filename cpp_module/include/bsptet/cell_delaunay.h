@@ -32,6 +32,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "bsptet/bsp_complex.h"
@@ -59,5 +60,21 @@ struct CellDelaunay {
 /// ImplicitGeometry::known_on_plane they decide coplanar cases without arithmetic (speed only).
 bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::vector<Index>& planes,
                    std::uint64_t seed, CellDelaunay& out);
+
+/// Boundary recovery for a cell whose Delaunay boundary differs from its faces' triangulations on
+/// some facet planes. `tets` (positive, tiling the cell) is modified in place; `want` holds the
+/// required boundary triangles, outward (counter-clockwise seen from outside), each with its plane.
+/// For each plane P whose triangles differ: the cavity C of the tets with a face on P (then grown by
+/// face neighbours, up to `max_layers` times) is re-filled by the cone from one of its vertices v
+/// over C's boundary, with P's Delaunay triangles replaced by the required ones. Valid by the chain
+/// argument of steiner_removal.h: the new boundary Z is a closed cycle (both triangulations of P's
+/// facet have the same boundary edges: every point on it is a vertex of both), the cone v * Z has
+/// boundary Z (the cones over faces through v are flat, zero chains), so when every other cone tet
+/// is strictly positive (checked exactly) they tile C once and keep Z as C's boundary. Returns true
+/// when the boundary of
+/// the resulting tets equals `want` exactly (recomputed from the tets), false otherwise (tets then
+/// unspecified).
+bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,
+                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_layers);
 
 }  // namespace bsptet

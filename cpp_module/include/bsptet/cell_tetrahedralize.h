@@ -25,7 +25,9 @@
 // perturbed 3D Delaunay tetrahedralization of its vertices (Bowyer-Watson), accepted only when its
 // boundary is exactly the union of the cell's face triangulations (the consistency argument is in
 // cell_delaunay.h). A cell whose Delaunay boundary does not match (a facet made of several BSP
-// faces whose common edges the Delaunay crosses) or that fails a check falls back, with the same
+// faces whose common edges the Delaunay crosses, e.g. a surface face split along an input edge)
+// is repaired facet by facet (recover_cell_boundary: a cavity of Delaunay tets re-coned from one
+// of its vertices, no new point); when that fails too, or a check fails, it falls back, with the same
 // face triangulations, to: pulled from a vertex v when every face on a plane through v is already
 // triangulated as triangles that all contain v (then the cone from v over the other faces tiles
 // the cell); else coned from an explicit interior apex; else from the implicit centroid apex.
@@ -52,6 +54,7 @@ struct CellTets {
   std::vector<Index> boundary_triangle;        ///< the input triangle that contains each boundary face
   std::int64_t inside_cells = 0, apex_cells = 0, pulled_cells = 0;
   std::int64_t delaunay_cells = 0;           ///< inside cells filled by their Delaunay tets (kDelaunay)
+  std::int64_t recovered_cells = 0;          ///< of which boundary-recovered (recover_cell_boundary)
   std::int64_t delaunay_fallback_cells = 0;  ///< inside cells (> 4 vertices) whose Delaunay was not used
 };
 

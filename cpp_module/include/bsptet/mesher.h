@@ -45,7 +45,7 @@ struct MeshStats {
   std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
   std::int64_t steiner_before_removal = 0, boundary_steiner_before_removal = 0, collapsed = 0, relocated = 0, pushed = 0;
   std::int64_t apex_cells = 0, pulled_cells = 0;
-  std::int64_t delaunay_cells = 0, delaunay_fallback_cells = 0;  ///< cell_tetrahedralize.h CellTets
+  std::int64_t delaunay_cells = 0, delaunay_recovered_cells = 0, delaunay_fallback_cells = 0;  ///< CellTets
   std::int64_t exact_fallbacks = 0;
   std::map<std::string, double> seconds_by_stage;
   double seconds_total = 0;
