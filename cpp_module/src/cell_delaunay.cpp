@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <utility>
 
@@ -396,8 +397,110 @@ std::vector<Tri> chain_boundary(const std::vector<std::array<Index, 4>>& tets, c
 
 }  // namespace
 
+namespace {
+
+std::vector<Tri> all_boundary(const std::vector<std::array<Index, 4>>& tets) {
+  std::vector<std::size_t> ids(tets.size());
+  for (std::size_t i = 0; i < tets.size(); ++i) ids[i] = i;
+  return chain_boundary(tets, ids);
+}
+
+// Replaces the cell-boundary triangles `remove` (outward, canonical, sorted; all faces of the
+// current tets) by `add` (same region, same boundary edges). The cavity C starts as the tets with
+// a face in `remove` (plus the tets containing every vertex of `must_contain`, if given); for each
+// candidate apex v (the vertices of C's boundary, by id, at most max_apexes of them), every face of
+// C's boundary (with `remove` swapped for `add`) that does not contain v and that v does not see
+// strictly takes the tet beyond it into C (never across the cell boundary: then v is given up),
+// until v sees them all (at most max_growth rounds); C is then re-filled by the cone from v. Valid
+// by the chain argument (recover_cell_boundary). `hull` (sorted) is the boundary of `tets`, kept
+// up to date.
+bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std::vector<Tri>& hull,
+            const std::vector<Tri>& remove, const std::vector<Tri>& add, const std::vector<Index>& must_contain,
+            int max_growth) {
+  constexpr std::size_t max_apexes = 16;
+  std::vector<char> in0(tets.size(), 0);
+  for (std::size_t i = 0; i < tets.size(); ++i) {
+    for (const Tri& f : outward_faces(tets[i]))
+      if (std::binary_search(remove.begin(), remove.end(), f)) in0[i] = 1;
+    if (!must_contain.empty()) {
+      bool all = true;
+      for (Index v : must_contain) all = all && std::find(tets[i].begin(), tets[i].end(), v) != tets[i].end();
+      if (all) in0[i] = 1;
+    }
+  }
+  // Tet beyond each face: outward face -> tet.
+  std::vector<std::pair<Tri, std::size_t>> owner;
+  for (std::size_t i = 0; i < tets.size(); ++i)
+    for (const Tri& f : outward_faces(tets[i])) owner.push_back({f, i});
+  std::sort(owner.begin(), owner.end());
+  auto boundary_of = [&](const std::vector<char>& in) {
+    std::vector<std::size_t> ids;
+    for (std::size_t i = 0; i < tets.size(); ++i)
+      if (in[i]) ids.push_back(i);
+    std::vector<Tri> bnd;
+    for (const Tri& f : chain_boundary(tets, ids))
+      if (!std::binary_search(remove.begin(), remove.end(), f)) bnd.push_back(f);
+    bnd.insert(bnd.end(), add.begin(), add.end());
+    return bnd;
+  };
+  std::vector<Index> cand;
+  for (const Tri& f : boundary_of(in0))
+    for (Index v : f) cand.push_back(v);
+  std::sort(cand.begin(), cand.end());
+  cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+  if (cand.size() > max_apexes) cand.resize(max_apexes);
+  std::vector<std::array<Index, 4>> fill;
+  for (Index v : cand) {
+    std::vector<char> in = in0;
+    for (int round = 0; round <= max_growth; ++round) {
+      const std::vector<Tri> bnd = boundary_of(in);
+      fill.clear();
+      std::vector<Tri> unseen;
+      for (const Tri& f : bnd) {
+        if (f[0] == v || f[1] == v || f[2] == v) continue;  // a flat cone; the face stays (chain argument)
+        const std::array<Index, 4> t{{f[0], f[2], f[1], v}};
+        if (geo.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive)
+          fill.push_back(t);
+        else
+          unseen.push_back(f);
+      }
+      if (unseen.empty()) {
+        std::vector<std::array<Index, 4>> next;
+        for (std::size_t i = 0; i < tets.size(); ++i)
+          if (!in[i]) next.push_back(tets[i]);
+        next.insert(next.end(), fill.begin(), fill.end());
+        tets.swap(next);
+        std::vector<Tri> h;
+        std::set_difference(hull.begin(), hull.end(), remove.begin(), remove.end(), std::back_inserter(h));
+        h.insert(h.end(), add.begin(), add.end());
+        std::sort(h.begin(), h.end());
+        hull.swap(h);
+        return true;
+      }
+      bool stuck = false;
+      for (const Tri& f : unseen) {
+        if (std::binary_search(hull.begin(), hull.end(), f) ||
+            std::find(add.begin(), add.end(), f) != add.end()) {
+          stuck = true;  // a face of the cell boundary: cannot grow across it
+          break;
+        }
+        const auto it = std::lower_bound(owner.begin(), owner.end(), std::make_pair(reversed(f), std::size_t(0)));
+        if (it == owner.end() || it->first != reversed(f)) {
+          stuck = true;
+          break;
+        }
+        in[it->second] = 1;
+      }
+      if (stuck) break;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,
-                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_layers) {
+                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_growth) {
   std::vector<Index> planes;
   for (const auto& w : want) planes.push_back(w.second);
   std::sort(planes.begin(), planes.end());
@@ -408,86 +511,85 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
   auto on_plane = [&](const Tri& t, Index p) {
     return geo.known_on_plane(t[0], p) && geo.known_on_plane(t[1], p) && geo.known_on_plane(t[2], p);
   };
-  for (Index p : planes) {
-    std::vector<std::size_t> ids_all(tets.size());
-    for (std::size_t i = 0; i < tets.size(); ++i) ids_all[i] = i;
-    const std::vector<Tri> hull = chain_boundary(tets, ids_all);
-    std::vector<Tri> have_p, want_p;
+  std::vector<Tri> hull = all_boundary(tets);
+  auto current = [&](Index p) {
+    std::vector<Tri> have;
     for (const Tri& t : hull)
-      if (on_plane(t, p)) have_p.push_back(t);
+      if (on_plane(t, p)) have.push_back(t);
+    return have;
+  };
+  auto has_edge = [](const std::vector<Tri>& tris, Index a, Index b) {
+    for (const Tri& t : tris)
+      for (int k = 0; k < 3; ++k)
+        if ((t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a)) return true;
+    return false;
+  };
+  for (Index p : planes) {
+    std::vector<Tri> want_p;
     for (const auto& w : want)
       if (w.second == p) want_p.push_back(canonical_tri(w.first));
     std::sort(want_p.begin(), want_p.end());
-    if (have_p == want_p) continue;
-    // Cavity: the tets with a face among have_p.
-    std::vector<char> in(tets.size(), 0);
-    for (std::size_t i = 0; i < tets.size(); ++i)
-      for (const Tri& f : outward_faces(tets[i]))
-        if (std::binary_search(have_p.begin(), have_p.end(), f)) in[i] = 1;
-    bool done = false;
-    for (int layer = 0; layer <= max_layers && !done; ++layer) {
-      std::vector<std::size_t> ids;
-      for (std::size_t i = 0; i < tets.size(); ++i)
-        if (in[i]) ids.push_back(i);
-      std::vector<Tri> bnd;
-      for (const Tri& f : chain_boundary(tets, ids))
-        if (!std::binary_search(have_p.begin(), have_p.end(), f)) bnd.push_back(f);
-      const std::size_t outer = bnd.size();  // faces [0, outer) are not on P
-      bnd.insert(bnd.end(), want_p.begin(), want_p.end());
-      // Faces of the cavity boundary on the cell boundary (the cavity does not grow across them).
-      std::vector<char> on_cell(bnd.size(), 0);
-      for (std::size_t k = 0; k < bnd.size(); ++k)
-        on_cell[k] = k >= outer || std::binary_search(hull.begin(), hull.end(), bnd[k]);
-      std::vector<Index> cand;
-      for (const Tri& f : bnd)
-        for (Index v : f) cand.push_back(v);
-      std::sort(cand.begin(), cand.end());
-      cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
-      std::vector<std::array<Index, 4>> fill;
-      for (Index v : cand) {
-        fill.clear();
-        bool ok = true;
-        for (std::size_t k = 0; k < bnd.size() && ok; ++k) {
-          const Tri& f = bnd[k];
-          if (f[0] == v || f[1] == v || f[2] == v) continue;  // a flat cone; the face stays (chain argument)
-          const std::array<Index, 4> t{{f[0], f[2], f[1], v}};
-          if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) ok = false;
-          fill.push_back(t);
-        }
-        if (!ok) continue;
-        std::vector<std::array<Index, 4>> next;
-        for (std::size_t i = 0; i < tets.size(); ++i)
-          if (!in[i]) next.push_back(tets[i]);
-        next.insert(next.end(), fill.begin(), fill.end());
-        tets.swap(next);
-        done = true;
-        break;
-      }
-      if (done) break;
-      // Grow by the face neighbours of the cavity (across faces not on the cell boundary).
-      std::vector<Tri> grow;
-      for (std::size_t k = 0; k < outer; ++k)
-        if (!on_cell[k]) grow.push_back(reversed(bnd[k]));
-      std::sort(grow.begin(), grow.end());
-      bool grew = false;
-      for (std::size_t i = 0; i < tets.size(); ++i) {
-        if (in[i]) continue;
-        for (const Tri& f : outward_faces(tets[i]))
-          if (std::binary_search(grow.begin(), grow.end(), f)) {
-            in[i] = 1;
-            grew = true;
+    if (current(p) == want_p) continue;
+    Sign ns = Sign::kZero;
+    const int axis = geo.projection_axis(p, &ns);
+    // Sloan's edge insertion on P, each 2D flip done in 3D by a small cavity: for every edge (c, d)
+    // of the wanted triangulation that is missing, flip edges crossing it (strictly convex quads)
+    // until it appears. Edges of the wanted triangulation never cross, so none is flipped away.
+    bool flips_ok = true;
+    for (const Tri& w : want_p) {
+      for (int k = 0; k < 3 && flips_ok; ++k) {
+        const Index c = w[k], d = w[(k + 1) % 3];
+        std::size_t guard = 0;
+        std::vector<std::pair<Index, Sign>> side_of;  // orient2d(c, d, v), cached per target edge
+        auto side_cd = [&](Index v) {
+          for (const auto& sv : side_of)
+            if (sv.first == v) return sv.second;
+          const Sign sv = geo.orient2d(c, d, v, axis);
+          side_of.push_back({v, sv});
+          return sv;
+        };
+        while (flips_ok) {
+          const std::vector<Tri> have = current(p);
+          if (has_edge(have, c, d)) break;
+          if (++guard > 4 * have.size() + 16) {
+            flips_ok = false;
             break;
           }
+          bool flipped = false;
+          // Candidate edges (a, b) of `have` between two triangles (a, b, x) and (b, a, y).
+          for (std::size_t i = 0; i < have.size() && !flipped; ++i)
+            for (int e = 0; e < 3 && !flipped; ++e) {
+              const Index a = have[i][e], b = have[i][(e + 1) % 3], x = have[i][(e + 2) % 3];
+              if (a == c || a == d || b == c || b == d) continue;
+              const Sign sa = side_cd(a), sb = side_cd(b);
+              if (sa == Sign::kZero || sb == Sign::kZero || sa == sb) continue;
+              const Sign sc = geo.orient2d(a, b, c, axis), sd = geo.orient2d(a, b, d, axis);
+              if (sc == Sign::kZero || sd == Sign::kZero || sc == sd) continue;
+              Index y = -1;
+              for (const Tri& t : have)
+                for (int q = 0; q < 3; ++q)
+                  if (t[q] == b && t[(q + 1) % 3] == a) y = t[(q + 2) % 3];
+              if (y < 0) continue;
+              const Sign s0 = geo.orient2d(a, b, x, axis);
+              if (geo.orient2d(a, y, x, axis) != s0 || geo.orient2d(y, b, x, axis) != s0) continue;
+              std::vector<Tri> remove{canonical_tri({a, b, x}), canonical_tri({b, a, y})};
+              std::sort(remove.begin(), remove.end());
+              const std::vector<Tri> add{canonical_tri({a, y, x}), canonical_tri({y, b, x})};
+              flipped = recone(geo, tets, hull, remove, add, {a, b}, max_growth);
+            }
+          if (!flipped) flips_ok = false;
+        }
       }
-      if (!grew) break;
+      if (!flips_ok) break;
     }
-    if (!done) return false;
+    (void)ns;
+    if (current(p) == want_p) continue;
+    // Whole facet at once.
+    if (!recone(geo, tets, hull, current(p), want_p, {}, max_growth)) return false;
   }
-  std::vector<std::size_t> ids_all(tets.size());
-  for (std::size_t i = 0; i < tets.size(); ++i) ids_all[i] = i;
   for (const auto& t : tets)
     if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
-  return chain_boundary(tets, ids_all) == want_all;
+  return all_boundary(tets) == want_all;
 }
 
 }  // namespace bsptet

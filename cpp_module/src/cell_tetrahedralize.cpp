@@ -375,7 +375,7 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
         for (const auto& t : tris_of(f))
           want_planes.push_back({positive_side ? std::array<Index, 3>{t[0], t[2], t[1]} : t, faces[f].plane});
       }
-      if (recover_cell_boundary(geo, dt.tets, want_planes, 3)) {
+      if (recover_cell_boundary(geo, dt.tets, want_planes, 8)) {
         ++out.delaunay_cells;
         ++out.recovered_cells;
         out.tets.insert(out.tets.end(), dt.tets.begin(), dt.tets.end());

@@ -59,6 +59,12 @@ T det4_homog(const std::array<T, 4>& r0, const std::array<T, 4>& r1, const std::
          m(r0, r1, 1, 2) * m(r2, r3, 0, 3) - m(r0, r1, 1, 3) * m(r2, r3, 0, 2) + m(r0, r1, 2, 3) * m(r2, r3, 0, 1);
 }
 
+template <class T>
+T det3(const std::array<T, 3>& r0, const std::array<T, 3>& r1, const std::array<T, 3>& r2) {
+  return r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0]) +
+         r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]);
+}
+
 Sign to_sign(int s) { return s > 0 ? Sign::kPositive : (s < 0 ? Sign::kNegative : Sign::kZero); }
 
 }  // namespace
@@ -226,6 +232,20 @@ Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)
     return ::bsptet::orient3d(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
                             points_[vd.explicit_id]);
+  {
+    const auto *ba = box(a), *bb = box(b), *bc = box(c), *bd = box(d);
+    if (ba && bb && bc && bd) {
+      // det[b - a, c - a, d - a] on the coordinate intervals.
+      std::array<Interval, 3> r0, r1, r2;
+      for (int k = 0; k < 3; ++k) {
+        r0[k] = (*bb)[k] - (*ba)[k];
+        r1[k] = (*bc)[k] - (*ba)[k];
+        r2[k] = (*bd)[k] - (*ba)[k];
+      }
+      const int s = det3<Interval>(r0, r1, r2).certain_sign();
+      if (s != 0) return to_sign(s);
+    }
+  }
   // det[[a 1]; [b 1]; [c 1]; [d 1]] = -det[b - a, c - a, d - a]; homogeneous rows scale it by the
   // product of the weights.
   const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c), &hd = vertex_interval(d);
@@ -247,6 +267,14 @@ Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0)
     return orient2d_projected(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id], axis);
+  {
+    const auto *ba = box(a), *bb = box(b), *bc = box(c);
+    if (ba && bb && bc) {
+      const int s = (((*bb)[u] - (*ba)[u]) * ((*bc)[v] - (*ba)[v]) - ((*bb)[v] - (*ba)[v]) * ((*bc)[u] - (*ba)[u]))
+                        .certain_sign();
+      if (s != 0) return to_sign(s);
+    }
+  }
   const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c);
   const int s = det3_homog<Interval>(ha, hb, hc, u, v).certain_sign();
   const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign();
@@ -277,11 +305,6 @@ int ImplicitGeometry::projection_axis(Index p, Sign* normal_sign) {
 
 namespace {
 
-template <class T>
-T det3(const std::array<T, 3>& r0, const std::array<T, 3>& r1, const std::array<T, 3>& r2) {
-  return r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0]) +
-         r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]);
-}
 
 // Vertex p relative to vertex e, both homogeneous (X, Y, Z, W): D = X_p W_e - X_e W_p (per
 // coordinate) and Q = W_p W_e, so p - e = D / Q.
@@ -334,7 +357,16 @@ std::array<T, 3> lifted_row2(const std::array<T, 4>& p, const std::array<T, 4>& 
 Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) {
   const std::array<Index, 5> ids{{a, b, c, d, e}};
   int s0 = 0;
-  {
+  const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d), *b4 = box(e);
+  if (b0 && b1 && b2 && b3 && b4) {
+    const std::array<const std::array<Interval, 3>*, 4> rows{{b0, b1, b2, b3}};
+    std::array<std::array<Interval, 4>, 4> r;
+    for (int i = 0; i < 4; ++i) {
+      const Interval dx = (*rows[i])[0] - (*b4)[0], dy = (*rows[i])[1] - (*b4)[1], dz = (*rows[i])[2] - (*b4)[2];
+      r[i] = {dx, dy, dz, dx * dx + dy * dy + dz * dz};
+    }
+    s0 = det4_homog<Interval>(r[0], r[1], r[2], r[3]).certain_sign();
+  } else {
     const auto& he = vertex_interval(e);
     const auto r0 = lifted_row3<Interval>(vertex_interval(a), he), r1 = lifted_row3<Interval>(vertex_interval(b), he),
                r2 = lifted_row3<Interval>(vertex_interval(c), he), r3 = lifted_row3<Interval>(vertex_interval(d), he);
@@ -383,7 +415,16 @@ Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis)
   const std::array<Index, 4> ids{{a, b, c, d}};
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   int s0 = 0;
-  {
+  const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d);
+  if (b0 && b1 && b2 && b3) {
+    const std::array<const std::array<Interval, 3>*, 3> rows{{b0, b1, b2}};
+    std::array<std::array<Interval, 3>, 3> r;
+    for (int i = 0; i < 3; ++i) {
+      const Interval dd[3] = {(*rows[i])[0] - (*b3)[0], (*rows[i])[1] - (*b3)[1], (*rows[i])[2] - (*b3)[2]};
+      r[i] = {dd[u], dd[v], dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]};
+    }
+    s0 = det3<Interval>(r[0], r[1], r[2]).certain_sign();
+  } else {
     const auto& hd = vertex_interval(d);
     s0 = det3<Interval>(lifted_row2<Interval>(vertex_interval(a), hd, u, v),
                         lifted_row2<Interval>(vertex_interval(b), hd, u, v),
@@ -425,6 +466,42 @@ Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis)
     if (m != 0) return to_sign(i % 2 == 0 ? m : -m);
   }
   return Sign::kZero;
+}
+
+const std::array<Interval, 3>* ImplicitGeometry::box(Index v) {
+  Vertex& vx = verts_[v];
+  if (vx.box_state < 0) {
+    vx.box_state = 0;
+    if (vx.explicit_id >= 0) {
+      const Vec3& p = points_[vx.explicit_id];
+      vx.box = {Interval(p.x), Interval(p.y), Interval(p.z)};
+      vx.box_state = 1;
+    } else {
+      const std::array<Interval, 4> h = vertex_interval(v);  // copy: vertex_interval may touch verts_
+      const Interval& w = h[3];
+      if (w.certain_sign() != 0 && std::isfinite(w.lo()) && std::isfinite(w.hi())) {
+        bool ok = true;
+        std::array<Interval, 3> b;
+        for (int k = 0; k < 3 && ok; ++k) {
+          // X / W over the corners; each quotient is rounded to nearest (error <= half an ulp),
+          // so one ulp outward encloses the exact range (W excludes zero: monotone in each).
+          const double q[4] = {h[k].lo() / w.lo(), h[k].lo() / w.hi(), h[k].hi() / w.lo(), h[k].hi() / w.hi()};
+          double lo = q[0], hi = q[0];
+          for (double x : q) {
+            if (!std::isfinite(x)) ok = false;
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+          }
+          b[k] = Interval(std::nextafter(lo, -INFINITY), std::nextafter(hi, INFINITY));
+        }
+        if (ok) {
+          verts_[v].box = b;
+          verts_[v].box_state = 1;
+        }
+      }
+    }
+  }
+  return verts_[v].box_state == 1 ? &verts_[v].box : nullptr;
 }
 
 bool ImplicitGeometry::exact_double(Index v, Vec3* p) {

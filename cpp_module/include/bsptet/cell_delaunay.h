@@ -62,19 +62,23 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
                    std::uint64_t seed, CellDelaunay& out);
 
 /// Boundary recovery for a cell whose Delaunay boundary differs from its faces' triangulations on
-/// some facet planes. `tets` (positive, tiling the cell) is modified in place; `want` holds the
-/// required boundary triangles, outward (counter-clockwise seen from outside), each with its plane.
-/// For each plane P whose triangles differ: the cavity C of the tets with a face on P (then grown by
-/// face neighbours, up to `max_layers` times) is re-filled by the cone from one of its vertices v
-/// over C's boundary, with P's Delaunay triangles replaced by the required ones. Valid by the chain
-/// argument of steiner_removal.h: the new boundary Z is a closed cycle (both triangulations of P's
-/// facet have the same boundary edges: every point on it is a vertex of both), the cone v * Z has
-/// boundary Z (the cones over faces through v are flat, zero chains), so when every other cone tet
-/// is strictly positive (checked exactly) they tile C once and keep Z as C's boundary. Returns true
-/// when the boundary of
-/// the resulting tets equals `want` exactly (recomputed from the tets), false otherwise (tets then
-/// unspecified).
+/// some facet planes (a facet made of several BSP faces). `tets` (positive, tiling the cell) is
+/// modified in place; `want` holds the required boundary triangles, outward (counter-clockwise seen
+/// from outside), each with its plane. For each plane P whose triangles differ, Sloan's edge
+/// insertion in P's 2D triangulation: every missing edge (c, d) of the wanted triangulation is
+/// made by flipping edges (a, b) that cross it (strictly convex quadrilaterals; the wanted edges
+/// never cross each other, so none is flipped away). Each 2D flip is done in 3D by re-filling a
+/// cavity C (the tets around the edge (a, b), grown tet by tet across the faces the apex does not
+/// see, at most `max_growth` rounds, never across the cell boundary) with the cone from one of its
+/// vertices v over C's boundary with the two triangles swapped for the flipped pair. If a flip
+/// fails, the whole facet is swapped in one cavity the same way.
+/// Valid by the chain argument of steiner_removal.h: the new boundary Z of C is a closed cycle (the
+/// swapped triangles cover the same region with the same boundary edges), the cone v * Z has
+/// boundary Z (cones over faces through v are flat, zero chains), so when every other cone tet is
+/// strictly positive (checked exactly) they tile C once and keep Z. No new point, no epsilon.
+/// Returns true when every tet is positive and the boundary of the resulting tets equals `want`
+/// exactly (recomputed from the tets); false otherwise (tets then unspecified).
 bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,
-                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_layers);
+                           const std::vector<std::pair<std::array<Index, 3>, Index>>& want, int max_growth);
 
 }  // namespace bsptet

@@ -114,12 +114,17 @@ class ImplicitGeometry {
     bool rounded_ready = false;
     Vec3 rounded;  ///< cache of rounded()
     signed char is_double = -1;  ///< cache of exact_double(): -1 unknown, 0 no, 1 yes
+    signed char box_state = -1;  ///< cache of box(): -1 unknown, 0 unavailable, 1 ready
+    std::array<Interval, 3> box;  ///< intervals enclosing x, y, z (X / W)
   };
   /// True when vertex v's coordinates are exactly doubles (then *p holds them); decided exactly,
   /// once per vertex. Lets exact fallbacks on such vertices run on doubles (same signs, cheaper).
   bool exact_double(Index v, Vec3* p);
   /// A sufficient condition for coplanarity: the four vertices are known to lie on one plane.
   bool known_coplanar(Index a, Index b, Index c, Index d) const;
+  /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
+  /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
+  const std::array<Interval, 3>* box(Index v);
   void prepare_plane(Index p);
   const std::array<ExactFloat, 4>& plane_exact(Index p);
   const std::array<Interval, 4>& vertex_interval(Index v);
