@@ -416,7 +416,7 @@ std::vector<Tri> all_boundary(const std::vector<std::array<Index, 4>>& tets) {
 // up to date.
 bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std::vector<Tri>& hull,
             const std::vector<Tri>& remove, const std::vector<Tri>& add, const std::vector<Index>& must_contain,
-            int max_growth) {
+            int max_growth, std::int64_t& budget) {
   constexpr std::size_t max_apexes = 16;
   std::vector<char> in0(tets.size(), 0);
   for (std::size_t i = 0; i < tets.size(); ++i) {
@@ -428,15 +428,13 @@ bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std:
       if (all) in0[i] = 1;
     }
   }
-  // Tet beyond each face: outward face -> tet.
+  // Tet beyond each face: outward face -> tet (built when first needed).
   std::vector<std::pair<Tri, std::size_t>> owner;
-  for (std::size_t i = 0; i < tets.size(); ++i)
-    for (const Tri& f : outward_faces(tets[i])) owner.push_back({f, i});
-  std::sort(owner.begin(), owner.end());
   auto boundary_of = [&](const std::vector<char>& in) {
     std::vector<std::size_t> ids;
     for (std::size_t i = 0; i < tets.size(); ++i)
       if (in[i]) ids.push_back(i);
+    budget -= static_cast<std::int64_t>(ids.size());
     std::vector<Tri> bnd;
     for (const Tri& f : chain_boundary(tets, ids))
       if (!std::binary_search(remove.begin(), remove.end(), f)) bnd.push_back(f);
@@ -453,12 +451,14 @@ bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std:
   for (Index v : cand) {
     std::vector<char> in = in0;
     for (int round = 0; round <= max_growth; ++round) {
+      if (budget < 0) return false;
       const std::vector<Tri> bnd = boundary_of(in);
       fill.clear();
       std::vector<Tri> unseen;
       for (const Tri& f : bnd) {
         if (f[0] == v || f[1] == v || f[2] == v) continue;  // a flat cone; the face stays (chain argument)
         const std::array<Index, 4> t{{f[0], f[2], f[1], v}};
+        --budget;
         if (geo.orient3d(t[0], t[1], t[2], t[3]) == Sign::kPositive)
           fill.push_back(t);
         else
@@ -478,6 +478,12 @@ bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std:
         return true;
       }
       bool stuck = false;
+      if (owner.empty()) {
+        for (std::size_t i = 0; i < tets.size(); ++i)
+          for (const Tri& f : outward_faces(tets[i])) owner.push_back({f, i});
+        std::sort(owner.begin(), owner.end());
+        budget -= static_cast<std::int64_t>(tets.size());
+      }
       for (const Tri& f : unseen) {
         if (std::binary_search(hull.begin(), hull.end(), f) ||
             std::find(add.begin(), add.end(), f) != add.end()) {
@@ -512,6 +518,9 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
     return geo.known_on_plane(t[0], p) && geo.known_on_plane(t[1], p) && geo.known_on_plane(t[2], p);
   };
   std::vector<Tri> hull = all_boundary(tets);
+  // Work limit (tets visited and orientation tests), so that a large cell that cannot be repaired
+  // costs about as much as one that can: then it falls back.
+  std::int64_t budget = 4000 + 40 * static_cast<std::int64_t>(tets.size());
   auto current = [&](Index p) {
     std::vector<Tri> have;
     for (const Tri& t : hull)
@@ -575,7 +584,8 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
               std::vector<Tri> remove{canonical_tri({a, b, x}), canonical_tri({b, a, y})};
               std::sort(remove.begin(), remove.end());
               const std::vector<Tri> add{canonical_tri({a, y, x}), canonical_tri({y, b, x})};
-              flipped = recone(geo, tets, hull, remove, add, {a, b}, max_growth);
+              flipped = recone(geo, tets, hull, remove, add, {a, b}, max_growth, budget);
+              if (budget < 0) return false;
             }
           if (!flipped) flips_ok = false;
         }
@@ -585,7 +595,7 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
     (void)ns;
     if (current(p) == want_p) continue;
     // Whole facet at once.
-    if (!recone(geo, tets, hull, current(p), want_p, {}, max_growth)) return false;
+    if (!recone(geo, tets, hull, current(p), want_p, {}, max_growth, budget)) return false;
   }
   for (const auto& t : tets)
     if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;

@@ -76,6 +76,7 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
 /// swapped triangles cover the same region with the same boundary edges), the cone v * Z has
 /// boundary Z (cones over faces through v are flat, zero chains), so when every other cone tet is
 /// strictly positive (checked exactly) they tile C once and keep Z. No new point, no epsilon.
+/// Work is limited (about 4000 + 40 x #tets orientation tests and tet visits): past it, false.
 /// Returns true when every tet is positive and the boundary of the resulting tets equals `want`
 /// exactly (recomputed from the tets); false otherwise (tets then unspecified).
 bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,
