@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <set>
 #include <utility>
 
 #include "bsptet/cell_tetrahedralize.h"
@@ -34,15 +35,18 @@ std::vector<std::array<Index, 3>> delaunay_face(ImplicitGeometry& geo, const Bsp
   // valid triangulation either way, and it is computed once per face.
   const std::size_t cap = 8 * tris.size() * tris.size() + 64;
   for (std::size_t round = 0; round < cap; ++round) {
-    std::map<std::pair<Index, Index>, std::pair<std::size_t, int>> edge;
+    // Directed edge -> (triangle, position), sorted.
+    std::vector<std::pair<std::pair<Index, Index>, std::pair<std::size_t, int>>> edge;
     for (std::size_t t = 0; t < tris.size(); ++t)
-      for (int k = 0; k < 3; ++k) edge[{tris[t][k], tris[t][(k + 1) % 3]}] = {t, k};
+      for (int k = 0; k < 3; ++k) edge.push_back({{tris[t][k], tris[t][(k + 1) % 3]}, {t, k}});
+    std::sort(edge.begin(), edge.end());
     bool flipped = false;
     for (std::size_t t = 0; t < tris.size() && !flipped; ++t)
       for (int k = 0; k < 3 && !flipped; ++k) {
         const Index a = tris[t][k], b = tris[t][(k + 1) % 3], c = tris[t][(k + 2) % 3];
-        const auto it = edge.find({b, a});
-        if (it == edge.end() || it->second.first < t) continue;
+        const auto it = std::lower_bound(edge.begin(), edge.end(),
+                                         std::make_pair(std::make_pair(b, a), std::make_pair(std::size_t(0), 0)));
+        if (it == edge.end() || it->first != std::make_pair(b, a) || it->second.first < t) continue;
         const std::size_t u = it->second.first;
         const Index d = tris[u][(it->second.second + 2) % 3];
         if (geo.lifted_det2(a, b, c, d, axis) != ns) continue;
@@ -383,15 +387,30 @@ std::array<Tri, 4> outward_faces(const std::array<Index, 4>& t) {
   return f;
 }
 
-// The boundary of a set of tets (outward, canonical, sorted); interior pairs cancel.
+// The boundary of the chain of a set of tets (outward, canonical, sorted): per triangle, the
+// number of outward copies minus the number of reversed ones; a net multiplicity m != 0 gives |m|
+// copies of the triangle in its net orientation (so a comparison with a set of triangles fails
+// unless every |m| is 1).
 std::vector<Tri> chain_boundary(const std::vector<std::array<Index, 4>>& tets, const std::vector<std::size_t>& ids) {
-  std::vector<Tri> all;
+  std::vector<std::pair<Tri, int>> all;  // (sorted key, +1 / -1 by orientation parity)
   for (std::size_t i : ids)
-    for (const Tri& f : outward_faces(tets[i])) all.push_back(f);
+    for (const Tri& f : outward_faces(tets[i])) {
+      Tri key = f;
+      std::sort(key.begin(), key.end());
+      all.push_back({key, f[1] < f[2] ? 1 : -1});  // f is rotated to start with its smallest id
+    }
   std::sort(all.begin(), all.end());
   std::vector<Tri> out;
-  for (const Tri& f : all)
-    if (!std::binary_search(all.begin(), all.end(), reversed(f))) out.push_back(f);
+  for (std::size_t i = 0; i < all.size();) {
+    std::size_t j = i;
+    int net = 0;
+    for (; j < all.size() && all[j].first == all[i].first; ++j) net += all[j].second;
+    const Tri& k = all[i].first;  // k[0] < k[1] < k[2]: parity +1 is (k0, k1, k2)
+    const Tri t = net > 0 ? Tri{k[0], k[1], k[2]} : Tri{k[0], k[2], k[1]};
+    for (int m = 0; m < (net > 0 ? net : -net); ++m) out.push_back(t);
+    i = j;
+  }
+  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -405,54 +424,82 @@ std::vector<Tri> all_boundary(const std::vector<std::array<Index, 4>>& tets) {
   return chain_boundary(tets, ids);
 }
 
-// Replaces the cell-boundary triangles `remove` (outward, canonical, sorted; all faces of the
-// current tets) by `add` (same region, same boundary edges). The cavity C starts as the tets with
-// a face in `remove` (plus the tets containing every vertex of `must_contain`, if given); for each
-// candidate apex v (the vertices of C's boundary, by id, at most max_apexes of them), every face of
-// C's boundary (with `remove` swapped for `add`) that does not contain v and that v does not see
-// strictly takes the tet beyond it into C (never across the cell boundary: then v is given up),
-// until v sees them all (at most max_growth rounds); C is then re-filled by the cone from v. Valid
-// by the chain argument (recover_cell_boundary). `hull` (sorted) is the boundary of `tets`, kept
-// up to date.
-bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std::vector<Tri>& hull,
-            const std::vector<Tri>& remove, const std::vector<Tri>& add, const std::vector<Index>& must_contain,
-            int max_growth, std::int64_t& budget) {
+// The tets of one cell while its boundary is repaired: dead tets stay in place (ids are stable),
+// `owner` maps each outward face of a live tet to it, `hull` is the boundary of the live tets.
+struct CellMesh {
+  std::vector<std::array<Index, 4>> tets;
+  std::vector<char> alive;
+  std::map<Tri, std::size_t> owner;
+  std::set<Tri> hull;
+
+  void add_tet(const std::array<Index, 4>& t) {
+    tets.push_back(t);
+    alive.push_back(1);
+    for (const Tri& f : outward_faces(t)) owner[f] = tets.size() - 1;
+  }
+  void kill(std::size_t i) {
+    alive[i] = 0;
+    for (const Tri& f : outward_faces(tets[i])) owner.erase(f);
+  }
+  // The live tet beyond face f of the cavity (the owner of f reversed); -1 on the cell boundary.
+  std::int64_t beyond(const Tri& f) const {
+    const auto it = owner.find(reversed(f));
+    return it == owner.end() ? -1 : static_cast<std::int64_t>(it->second);
+  }
+};
+
+// Replaces the cell-boundary triangles `remove` (outward, canonical, sorted; all faces of live
+// tets) by `add` (same region, same boundary edges). The cavity C starts as the tets with a face in
+// `remove` (plus, when `edge` is given, every tet around that edge); for each candidate apex v (the
+// vertices of C's boundary, by id, at most 16 of them), every face of C's boundary (with `remove`
+// swapped for `add`) that does not contain v and that v does not see strictly takes the tet
+// beyond it into C (never across the cell boundary: then v is given up), until v sees them all (at
+// most max_growth rounds); C is then re-filled by the cone from v. Valid by the chain argument
+// (recover_cell_boundary). `budget` counts orientation tests and tets visited.
+bool recone(ImplicitGeometry& geo, CellMesh& m, const std::vector<Tri>& remove, const std::vector<Tri>& add,
+            const std::array<Index, 2>* edge, int max_growth, std::int64_t& budget) {
   constexpr std::size_t max_apexes = 16;
-  std::vector<char> in0(tets.size(), 0);
-  for (std::size_t i = 0; i < tets.size(); ++i) {
-    for (const Tri& f : outward_faces(tets[i]))
-      if (std::binary_search(remove.begin(), remove.end(), f)) in0[i] = 1;
-    if (!must_contain.empty()) {
-      bool all = true;
-      for (Index v : must_contain) all = all && std::find(tets[i].begin(), tets[i].end(), v) != tets[i].end();
-      if (all) in0[i] = 1;
+  std::vector<std::size_t> c0;
+  for (const Tri& f : remove) {
+    const auto it = m.owner.find(f);
+    if (it == m.owner.end()) return false;
+    c0.push_back(it->second);
+  }
+  if (edge) {
+    // Every tet around the edge: from the first one, across faces containing the edge.
+    for (std::size_t q = 0; q < c0.size(); ++q) {
+      const auto& t = m.tets[c0[q]];
+      for (const Tri& f : outward_faces(t)) {
+        if (std::find(f.begin(), f.end(), (*edge)[0]) == f.end() || std::find(f.begin(), f.end(), (*edge)[1]) == f.end())
+          continue;
+        const std::int64_t n = m.beyond(f);
+        if (n >= 0 && std::find(c0.begin(), c0.end(), static_cast<std::size_t>(n)) == c0.end())
+          c0.push_back(static_cast<std::size_t>(n));
+      }
     }
   }
-  // Tet beyond each face: outward face -> tet (built when first needed).
-  std::vector<std::pair<Tri, std::size_t>> owner;
-  auto boundary_of = [&](const std::vector<char>& in) {
-    std::vector<std::size_t> ids;
-    for (std::size_t i = 0; i < tets.size(); ++i)
-      if (in[i]) ids.push_back(i);
+  std::sort(c0.begin(), c0.end());
+  c0.erase(std::unique(c0.begin(), c0.end()), c0.end());
+  auto boundary_of = [&](const std::vector<std::size_t>& ids) {
     budget -= static_cast<std::int64_t>(ids.size());
     std::vector<Tri> bnd;
-    for (const Tri& f : chain_boundary(tets, ids))
+    for (const Tri& f : chain_boundary(m.tets, ids))
       if (!std::binary_search(remove.begin(), remove.end(), f)) bnd.push_back(f);
     bnd.insert(bnd.end(), add.begin(), add.end());
     return bnd;
   };
   std::vector<Index> cand;
-  for (const Tri& f : boundary_of(in0))
+  for (const Tri& f : boundary_of(c0))
     for (Index v : f) cand.push_back(v);
   std::sort(cand.begin(), cand.end());
   cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
   if (cand.size() > max_apexes) cand.resize(max_apexes);
   std::vector<std::array<Index, 4>> fill;
   for (Index v : cand) {
-    std::vector<char> in = in0;
+    std::vector<std::size_t> c = c0;
     for (int round = 0; round <= max_growth; ++round) {
       if (budget < 0) return false;
-      const std::vector<Tri> bnd = boundary_of(in);
+      const std::vector<Tri> bnd = boundary_of(c);
       fill.clear();
       std::vector<Tri> unseen;
       for (const Tri& f : bnd) {
@@ -465,39 +512,28 @@ bool recone(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets, std:
           unseen.push_back(f);
       }
       if (unseen.empty()) {
-        std::vector<std::array<Index, 4>> next;
-        for (std::size_t i = 0; i < tets.size(); ++i)
-          if (!in[i]) next.push_back(tets[i]);
-        next.insert(next.end(), fill.begin(), fill.end());
-        tets.swap(next);
-        std::vector<Tri> h;
-        std::set_difference(hull.begin(), hull.end(), remove.begin(), remove.end(), std::back_inserter(h));
-        h.insert(h.end(), add.begin(), add.end());
-        std::sort(h.begin(), h.end());
-        hull.swap(h);
+        for (std::size_t i : c) m.kill(i);
+        for (const auto& t : fill) m.add_tet(t);
+        for (const Tri& f : remove) m.hull.erase(f);
+        for (const Tri& f : add) m.hull.insert(f);
         return true;
       }
       bool stuck = false;
-      if (owner.empty()) {
-        for (std::size_t i = 0; i < tets.size(); ++i)
-          for (const Tri& f : outward_faces(tets[i])) owner.push_back({f, i});
-        std::sort(owner.begin(), owner.end());
-        budget -= static_cast<std::int64_t>(tets.size());
-      }
       for (const Tri& f : unseen) {
-        if (std::binary_search(hull.begin(), hull.end(), f) ||
-            std::find(add.begin(), add.end(), f) != add.end()) {
+        if (m.hull.count(f) || std::find(add.begin(), add.end(), f) != add.end()) {
           stuck = true;  // a face of the cell boundary: cannot grow across it
           break;
         }
-        const auto it = std::lower_bound(owner.begin(), owner.end(), std::make_pair(reversed(f), std::size_t(0)));
-        if (it == owner.end() || it->first != reversed(f)) {
+        const std::int64_t n = m.beyond(f);
+        if (n < 0) {
           stuck = true;
           break;
         }
-        in[it->second] = 1;
+        c.push_back(static_cast<std::size_t>(n));
       }
       if (stuck) break;
+      std::sort(c.begin(), c.end());
+      c.erase(std::unique(c.begin(), c.end()), c.end());
     }
   }
   return false;
@@ -517,30 +553,22 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
   auto on_plane = [&](const Tri& t, Index p) {
     return geo.known_on_plane(t[0], p) && geo.known_on_plane(t[1], p) && geo.known_on_plane(t[2], p);
   };
-  std::vector<Tri> hull = all_boundary(tets);
+  CellMesh m;
+  for (const auto& t : tets) m.add_tet(t);
+  for (const Tri& f : all_boundary(tets)) m.hull.insert(f);
   // Work limit (tets visited and orientation tests), so that a large cell that cannot be repaired
   // costs about as much as one that can: then it falls back.
-  std::int64_t budget = 4000 + 40 * static_cast<std::int64_t>(tets.size());
-  auto current = [&](Index p) {
-    std::vector<Tri> have;
-    for (const Tri& t : hull)
-      if (on_plane(t, p)) have.push_back(t);
-    return have;
-  };
-  auto has_edge = [](const std::vector<Tri>& tris, Index a, Index b) {
-    for (const Tri& t : tris)
-      for (int k = 0; k < 3; ++k)
-        if ((t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a)) return true;
-    return false;
-  };
+  std::int64_t budget = 20000 + 60 * static_cast<std::int64_t>(tets.size());
   for (Index p : planes) {
     std::vector<Tri> want_p;
     for (const auto& w : want)
       if (w.second == p) want_p.push_back(canonical_tri(w.first));
     std::sort(want_p.begin(), want_p.end());
-    if (current(p) == want_p) continue;
-    Sign ns = Sign::kZero;
-    const int axis = geo.projection_axis(p, &ns);
+    std::vector<Tri> have;
+    for (const Tri& t : m.hull)
+      if (on_plane(t, p)) have.push_back(t);
+    if (have == want_p) continue;
+    const int axis = geo.projection_axis(p);
     // Sloan's edge insertion on P, each 2D flip done in 3D by a small cavity: for every edge (c, d)
     // of the wanted triangulation that is missing, flip edges crossing it (strictly convex quads)
     // until it appears. Edges of the wanted triangulation never cross, so none is flipped away.
@@ -548,55 +576,71 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
     for (const Tri& w : want_p) {
       for (int k = 0; k < 3 && flips_ok; ++k) {
         const Index c = w[k], d = w[(k + 1) % 3];
-        std::size_t guard = 0;
-        std::vector<std::pair<Index, Sign>> side_of;  // orient2d(c, d, v), cached per target edge
+        std::map<Index, Sign> side_of;  // orient2d(c, d, v), per target edge
         auto side_cd = [&](Index v) {
-          for (const auto& sv : side_of)
-            if (sv.first == v) return sv.second;
-          const Sign sv = geo.orient2d(c, d, v, axis);
-          side_of.push_back({v, sv});
-          return sv;
+          const auto it = side_of.find(v);
+          if (it != side_of.end()) return it->second;
+          --budget;
+          return side_of[v] = geo.orient2d(c, d, v, axis);
         };
+        std::size_t guard = 0;
         while (flips_ok) {
-          const std::vector<Tri> have = current(p);
-          if (has_edge(have, c, d)) break;
+          budget -= static_cast<std::int64_t>(have.size());
+          if (budget < 0) return false;
+          // Directed edge -> opposite vertex, sorted.
+          std::vector<std::pair<std::pair<Index, Index>, Index>> third;
+          for (const Tri& t : have)
+            for (int q = 0; q < 3; ++q) third.push_back({{t[q], t[(q + 1) % 3]}, t[(q + 2) % 3]});
+          std::sort(third.begin(), third.end());
+          auto find_third = [&](Index u, Index w) {
+            const auto it = std::lower_bound(third.begin(), third.end(), std::make_pair(std::make_pair(u, w), Index(-1)));
+            return it != third.end() && it->first == std::make_pair(u, w) ? it->second : Index(-1);
+          };
+          if (find_third(c, d) >= 0 || find_third(d, c) >= 0) break;
           if (++guard > 4 * have.size() + 16) {
             flips_ok = false;
             break;
           }
           bool flipped = false;
-          // Candidate edges (a, b) of `have` between two triangles (a, b, x) and (b, a, y).
-          for (std::size_t i = 0; i < have.size() && !flipped; ++i)
-            for (int e = 0; e < 3 && !flipped; ++e) {
-              const Index a = have[i][e], b = have[i][(e + 1) % 3], x = have[i][(e + 2) % 3];
-              if (a == c || a == d || b == c || b == d) continue;
-              const Sign sa = side_cd(a), sb = side_cd(b);
-              if (sa == Sign::kZero || sb == Sign::kZero || sa == sb) continue;
-              const Sign sc = geo.orient2d(a, b, c, axis), sd = geo.orient2d(a, b, d, axis);
-              if (sc == Sign::kZero || sd == Sign::kZero || sc == sd) continue;
-              Index y = -1;
-              for (const Tri& t : have)
-                for (int q = 0; q < 3; ++q)
-                  if (t[q] == b && t[(q + 1) % 3] == a) y = t[(q + 2) % 3];
-              if (y < 0) continue;
-              const Sign s0 = geo.orient2d(a, b, x, axis);
-              if (geo.orient2d(a, y, x, axis) != s0 || geo.orient2d(y, b, x, axis) != s0) continue;
-              std::vector<Tri> remove{canonical_tri({a, b, x}), canonical_tri({b, a, y})};
-              std::sort(remove.begin(), remove.end());
-              const std::vector<Tri> add{canonical_tri({a, y, x}), canonical_tri({y, b, x})};
-              flipped = recone(geo, tets, hull, remove, add, {a, b}, max_growth, budget);
-              if (budget < 0) return false;
+          for (const auto& [ab, x] : third) {
+            const Index a = ab.first, b = ab.second;
+            if (a > b || a == c || a == d || b == c || b == d) continue;  // each edge once
+            const Sign sa = side_cd(a), sb = side_cd(b);
+            if (sa == Sign::kZero || sb == Sign::kZero || sa == sb) continue;
+            const Index y = find_third(b, a);
+            if (y < 0) continue;
+            budget -= 4;
+            const Sign sc = geo.orient2d(a, b, c, axis), sd = geo.orient2d(a, b, d, axis);
+            if (sc == Sign::kZero || sd == Sign::kZero || sc == sd) continue;
+            const Sign s0 = geo.orient2d(a, b, x, axis);
+            if (geo.orient2d(a, y, x, axis) != s0 || geo.orient2d(y, b, x, axis) != s0) continue;
+            std::vector<Tri> remove{canonical_tri({a, b, x}), canonical_tri({b, a, y})};
+            std::sort(remove.begin(), remove.end());
+            const std::vector<Tri> add{canonical_tri({a, y, x}), canonical_tri({y, b, x})};
+            const std::array<Index, 2> e{{a, b}};
+            if (recone(geo, m, remove, add, &e, max_growth, budget)) {
+              std::vector<Tri> h;
+              std::set_difference(have.begin(), have.end(), remove.begin(), remove.end(), std::back_inserter(h));
+              h.insert(h.end(), add.begin(), add.end());
+              std::sort(h.begin(), h.end());
+              have.swap(h);
+              flipped = true;
+              break;
             }
+            if (budget < 0) return false;
+          }
           if (!flipped) flips_ok = false;
         }
       }
       if (!flips_ok) break;
     }
-    (void)ns;
-    if (current(p) == want_p) continue;
+    if (have == want_p) continue;
     // Whole facet at once.
-    if (!recone(geo, tets, hull, current(p), want_p, {}, max_growth, budget)) return false;
+    if (!recone(geo, m, have, want_p, nullptr, max_growth, budget)) return false;
   }
+  tets.clear();
+  for (std::size_t i = 0; i < m.tets.size(); ++i)
+    if (m.alive[i]) tets.push_back(m.tets[i]);
   for (const auto& t : tets)
     if (geo.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
   return all_boundary(tets) == want_all;

@@ -528,6 +528,25 @@ bool ImplicitGeometry::known_coplanar(Index a, Index b, Index c, Index d) const 
   };
   for (Index q : verts_[a].on_planes)
     if (on(b, q) && on(c, q) && on(d, q)) return true;
+  // Three of them on one line are coplanar with any fourth: x, y, z are collinear when x is a TPI
+  // vertex and y, z lie on two of its three defining planes (independent planes: they meet in a
+  // line). This is a vertex a neighbour's split left on an edge, with points of that edge.
+  auto collinear = [&](Index x, Index y, Index z) {
+    const Vertex& vx = verts_[x];
+    if (vx.explicit_id >= 0 || vx.centroid_of[0] >= 0) return false;
+    int common = 0;
+    for (Index q : vx.planes)
+      if (on(y, q) && on(z, q)) ++common;
+    return common >= 2;
+  };
+  const std::array<Index, 4> v{{a, b, c, d}};
+  for (int skip = 0; skip < 4; ++skip) {
+    std::array<Index, 3> t;
+    int n = 0;
+    for (int i = 0; i < 4; ++i)
+      if (i != skip) t[n++] = v[i];
+    if (collinear(t[0], t[1], t[2]) || collinear(t[1], t[2], t[0]) || collinear(t[2], t[0], t[1])) return true;
+  }
   return false;
 }
 

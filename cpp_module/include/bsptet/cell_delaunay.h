@@ -17,17 +17,23 @@
 //     same heights (the lower faces of the lifted hull above the face F of the convex hull are the
 //     lower faces of the lifted points above F; an affine parameterization of F's plane keeps
 //     "below"). When F carries one BSP face, that is exactly the face's triangulation of 1.
-//  3. When F carries several BSP faces (a neighbour was split, this cell was not), the 3D hull may
-//     cross their common edges. So the caller compares, per cell, the hull triangles with the union
-//     of its faces' triangulations (1.), as oriented triangles. Only an exact match is accepted;
-//     the tets then meet every neighbour on the shared face's one triangulation. A mismatch sends
-//     the cell to the cone fillers (cell_tetrahedralize.h), which use the same face triangulations.
+//  3. When F carries several BSP faces (a neighbour was split, this cell was not; or a surface face
+//     was split along an input edge), the 3D hull may cross their common edges. So the caller
+//     compares, per cell, the boundary of its tets (recomputed from the tets as a chain) with the
+//     union of its faces' triangulations (1.), as oriented triangles. Only an exact match is
+//     accepted; the tets then meet every neighbour on the shared face's one triangulation. A
+//     mismatch is repaired by recover_cell_boundary (below), whose result is compared the same
+//     way; if that fails too, the cell goes to the cone fillers (cell_tetrahedralize.h), which use
+//     the same face triangulations.
 // Validity of the tets: the Delaunay triangulation of the cell's vertices tiles their convex hull,
 // which is the (convex) cell; Bowyer-Watson never makes a flat tet under the perturbation (a
 // coplanar point on a hull face is in conflict with the outside of that face exactly when it is
 // in conflict with the tet inside, since the circumsphere meets the plane in the circumcircle);
 // and every output tet is also re-checked to be strictly positive (exact orient3d), else the cell
-// falls back as in 3. No epsilon anywhere: every decision is an exact sign.
+// falls back as in 3. Independently of the algorithm's correctness, what is accepted is proved by
+// the checks: tets all strictly positive whose boundary chain is exactly the cell's boundary cycle
+// cover every point of the cell with winding number 1, hence tile it once. No epsilon anywhere:
+// every decision is an exact sign.
 #pragma once
 
 #include <array>
@@ -76,7 +82,7 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
 /// swapped triangles cover the same region with the same boundary edges), the cone v * Z has
 /// boundary Z (cones over faces through v are flat, zero chains), so when every other cone tet is
 /// strictly positive (checked exactly) they tile C once and keep Z. No new point, no epsilon.
-/// Work is limited (about 4000 + 40 x #tets orientation tests and tet visits): past it, false.
+/// Work is limited (about 20000 + 60 x #tets orientation tests and tets visited): past it, false.
 /// Returns true when every tet is positive and the boundary of the resulting tets equals `want`
 /// exactly (recomputed from the tets); false otherwise (tets then unspecified).
 bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 4>>& tets,

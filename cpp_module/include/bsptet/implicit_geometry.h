@@ -120,7 +120,8 @@ class ImplicitGeometry {
   /// True when vertex v's coordinates are exactly doubles (then *p holds them); decided exactly,
   /// once per vertex. Lets exact fallbacks on such vertices run on doubles (same signs, cheaper).
   bool exact_double(Index v, Vec3* p);
-  /// A sufficient condition for coplanarity: the four vertices are known to lie on one plane.
+  /// A sufficient condition for coplanarity (no arithmetic): the four vertices are known to lie on
+  /// one plane, or three of them on one line (two defining planes of a TPI vertex).
   bool known_coplanar(Index a, Index b, Index c, Index d) const;
   /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
   /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
