@@ -470,8 +470,9 @@ bool recone(ImplicitGeometry& geo, CellMesh& m, const std::vector<Tri>& remove, 
     for (std::size_t q = 0; q < c0.size(); ++q) {
       const auto& t = m.tets[c0[q]];
       for (const Tri& f : outward_faces(t)) {
-        if (std::find(f.begin(), f.end(), (*edge)[0]) == f.end() || std::find(f.begin(), f.end(), (*edge)[1]) == f.end())
-          continue;
+        const bool has0 = std::find(f.begin(), f.end(), (*edge)[0]) != f.end();
+        const bool has1 = std::find(f.begin(), f.end(), (*edge)[1]) != f.end();
+        if (!has0 || !has1) continue;
         const std::int64_t n = m.beyond(f);
         if (n >= 0 && std::find(c0.begin(), c0.end(), static_cast<std::size_t>(n)) == c0.end())
           c0.push_back(static_cast<std::size_t>(n));
@@ -593,7 +594,8 @@ bool recover_cell_boundary(ImplicitGeometry& geo, std::vector<std::array<Index, 
             for (int q = 0; q < 3; ++q) third.push_back({{t[q], t[(q + 1) % 3]}, t[(q + 2) % 3]});
           std::sort(third.begin(), third.end());
           auto find_third = [&](Index u, Index w) {
-            const auto it = std::lower_bound(third.begin(), third.end(), std::make_pair(std::make_pair(u, w), Index(-1)));
+            const auto key = std::make_pair(std::make_pair(u, w), Index(-1));
+            const auto it = std::lower_bound(third.begin(), third.end(), key);
             return it != third.end() && it->first == std::make_pair(u, w) ? it->second : Index(-1);
           };
           if (find_third(c, d) >= 0 || find_third(d, c) >= 0) break;

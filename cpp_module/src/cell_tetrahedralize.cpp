@@ -409,7 +409,8 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
       continue;
     }
     Vec3 p;
-    Index apex = find_explicit_apex(geo, faces, cells[c], ci, cv, p) ? geo.add_explicit_point(p) : implicit_apex(geo, cv);
+    const Index apex =
+        find_explicit_apex(geo, faces, cells[c], ci, cv, p) ? geo.add_explicit_point(p) : implicit_apex(geo, cv);
     if (apex < 0)
       throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(c),
                          "cell " + std::to_string(c) + " has no four non-coplanar vertices");

@@ -1,7 +1,10 @@
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
-//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] [--write STEM]
+//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient]
+//               [--write STEM]
+//
+// --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
 //
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
 // shells facing the wrong way); --reorient flips triangles as that check allows.
@@ -22,7 +25,9 @@ using namespace bsptet;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] [--write STEM]\n",
+    std::fprintf(stderr,
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] "
+                 "[--write STEM]\n",
                  argv[0]);
     return 2;
   }
