@@ -148,10 +148,11 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "tetrahedralize",
       [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
-         py::object cancel) {
+         py::object cancel, bool cone_cells) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
+        o.cone_cells = cone_cells;
         TetMesh mesh;
         MeshStats st;
         run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
@@ -173,14 +174,20 @@ PYBIND11_MODULE(_bsptet, m) {
         d["collapsed"] = st.collapsed;
         d["relocated"] = st.relocated;
         d["exact_fallbacks"] = st.exact_fallbacks;
+        d["delaunay_cells"] = st.delaunay_cells;
+        d["delaunay_recovered_cells"] = st.delaunay_recovered_cells;
+        d["delaunay_fallback_cells"] = st.delaunay_fallback_cells;
+        d["apex_cells"] = st.apex_cells;
+        d["pulled_cells"] = st.pulled_cells;
         d["seconds_by_stage"] = st.seconds_by_stage;
         d["seconds_core"] = st.seconds_total;
         return py::make_tuple(points_array(mesh), tets_array(mesh), d);
       },
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("cone_cells") = false,
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
-      "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError.");
+      "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
+      "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison.");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "bsptet/cell_delaunay.h"
 #include "bsptet/errors.h"
 
 namespace bsptet {
@@ -52,9 +53,118 @@ std::vector<std::array<Index, 3>> fan_face(const BspFace& face, Index v) {
   return out;
 }
 
-}  // namespace
+// An explicit point strictly inside convex cell c (the rounded centroid of its vertices `cv`, then
+// points pulled towards each vertex), verified exactly against every face plane.
+bool find_explicit_apex(ImplicitGeometry& geo, const std::vector<BspFace>& faces, const BspCell& cell, Index c,
+                        const std::vector<Index>& cv, Vec3& apex) {
+  std::vector<Vec3> approx;
+  Vec3 centroid{0, 0, 0};
+  for (Index v : cv) {
+    approx.push_back(geo.rounded(v));
+    centroid.x += approx.back().x / cv.size();
+    centroid.y += approx.back().y / cv.size();
+    centroid.z += approx.back().z / cv.size();
+  }
+  auto strictly_inside = [&](const Vec3& p) {
+    for (Index f : cell.faces) {
+      const Sign want = faces[f].cell[0] == c ? Sign::kPositive : Sign::kNegative;
+      const PlaneDef& pd = geo.plane(faces[f].plane);
+      if (orient3d(geo.explicit_point(pd.a), geo.explicit_point(pd.b), geo.explicit_point(pd.c), p) != want)
+        return false;
+    }
+    return true;
+  };
+  if (strictly_inside(centroid)) {
+    apex = centroid;
+    return true;
+  }
+  for (std::size_t k = 0; k < approx.size(); ++k)
+    for (double w : {0.5, 0.9, 0.99}) {
+      const Vec3 p{w * centroid.x + (1 - w) * approx[k].x, w * centroid.y + (1 - w) * approx[k].y,
+                   w * centroid.z + (1 - w) * approx[k].z};
+      if (strictly_inside(p)) {
+        apex = p;
+        return true;
+      }
+    }
+  return false;
+}
 
-CellTets tetrahedralize_cells(BspComplex& bsp, const CellLabels& labels) {
+// The implicit apex: the exact centroid of four non-coplanar vertices of the cell; -1 if none.
+Index implicit_apex(ImplicitGeometry& geo, const std::vector<Index>& cv) {
+  for (std::size_t h = 1; h < cv.size(); ++h)
+    for (std::size_t i = h + 1; i < cv.size(); ++i)
+      for (std::size_t j = i + 1; j < cv.size(); ++j)
+        if (geo.orient3d(cv[0], cv[h], cv[i], cv[j]) != Sign::kZero)
+          return geo.add_centroid_vertex({cv[0], cv[h], cv[i], cv[j]});
+  return -1;
+}
+
+std::vector<Index> cell_vertices(const std::vector<BspFace>& faces, const BspCell& cell) {
+  std::vector<Index> cv;
+  for (Index f : cell.faces)
+    for (Index v : faces[f].verts) cv.push_back(v);
+  std::sort(cv.begin(), cv.end());
+  cv.erase(std::unique(cv.begin(), cv.end()), cv.end());
+  return cv;
+}
+
+// The tet of a cell with four vertices, oriented by one of its faces.
+std::array<Index, 4> tet_cell(const std::vector<BspFace>& faces, const BspCell& cell, Index c) {
+  const BspFace& face = faces[cell.faces[0]];
+  Index d = -1;
+  for (Index f : cell.faces)
+    for (Index v : faces[f].verts)
+      if (std::find(face.verts.begin(), face.verts.end(), v) == face.verts.end()) d = v;
+  const auto& t = face.verts;
+  if (face.cell[0] == c) return {t[0], t[1], t[2], d};
+  return {t[0], t[2], t[1], d};
+}
+
+// Boundary faces: between an inside and an outside cell; outward is -n when the inside cell is on
+// the positive side.
+template <class TrisOf>
+void boundary_faces(const std::vector<BspFace>& faces, const CellLabels& labels, TrisOf&& tris_of, CellTets& out) {
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const BspFace& face = faces[f];
+    if (!face.alive) continue;
+    const int w0 = face.cell[0] >= 0 ? labels.winding[face.cell[0]] : 0;
+    const int w1 = face.cell[1] >= 0 ? labels.winding[face.cell[1]] : 0;
+    if (w0 == w1) continue;
+    if (face.coplanar.empty() || labels.coverage[f] == 0)
+      throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(f),
+                         "a face between inside and outside is not covered by an input triangle");
+    for (const auto& t : tris_of(static_cast<Index>(f))) {
+      if (w0 == 1)
+        out.boundary.push_back({t[0], t[2], t[1]});
+      else
+        out.boundary.push_back(t);
+      out.boundary_triangle.push_back(face.coplanar[0]);
+    }
+  }
+}
+
+// Cone from `apex` over the triangles of the cell's faces (skipping faces whose plane contains the
+// apex when `skip_through_apex`, for a pulled cell).
+template <class TrisOf>
+void cone_cell(ImplicitGeometry& geo, const std::vector<BspFace>& faces, const BspCell& cell, Index c, Index apex,
+               bool skip_through_apex, TrisOf&& tris_of, CellTets& out) {
+  for (Index f : cell.faces) {
+    const BspFace& face = faces[f];
+    if (skip_through_apex && geo.side(face.plane, apex) == Sign::kZero) continue;
+    const bool positive_side = face.cell[0] == c;
+    for (const auto& t : tris_of(f)) {
+      // Face triangles are CCW around n. On the positive side n points into the cell, so
+      // (a, b, c, apex) is positive; on the negative side swap two vertices.
+      if (positive_side)
+        out.tets.push_back({t[0], t[1], t[2], apex});
+      else
+        out.tets.push_back({t[0], t[2], t[1], apex});
+    }
+  }
+}
+
+CellTets tetrahedralize_cells_cone(BspComplex& bsp, const CellLabels& labels) {
   ImplicitGeometry& geo = bsp.geometry();
   const auto& faces = bsp.faces();
   const auto& cells = bsp.cells();
@@ -75,38 +185,8 @@ CellTets tetrahedralize_cells(BspComplex& bsp, const CellLabels& labels) {
       kind[c] = 1;
       continue;
     }
-    // Apex: an explicit point strictly inside the cell (the rounded centroid of its vertices,
-    // then points pulled towards each vertex), verified exactly against every face plane.
-    std::vector<Vec3> approx;
-    Vec3 centroid{0, 0, 0};
-    for (Index v : cv) {
-      approx.push_back(geo.rounded(v));
-      centroid.x += approx.back().x / cv.size();
-      centroid.y += approx.back().y / cv.size();
-      centroid.z += approx.back().z / cv.size();
-    }
-    auto strictly_inside = [&](const Vec3& p) {
-      for (Index f : cells[c].faces) {
-        // Cheap double pre-test before creating a vertex.
-        const Sign want = faces[f].cell[0] == static_cast<Index>(c) ? Sign::kPositive : Sign::kNegative;
-        const PlaneDef& pd = geo.plane(faces[f].plane);
-        if (orient3d(geo.explicit_point(pd.a), geo.explicit_point(pd.b), geo.explicit_point(pd.c), p) != want)
-          return false;
-      }
-      return true;
-    };
-    bool found = strictly_inside(centroid);
-    Vec3 apex = centroid;
-    for (std::size_t k = 0; !found && k < approx.size(); ++k)
-      for (double w : {0.5, 0.9, 0.99}) {
-        const Vec3 p{w * centroid.x + (1 - w) * approx[k].x, w * centroid.y + (1 - w) * approx[k].y,
-                     w * centroid.z + (1 - w) * approx[k].z};
-        if ((found = strictly_inside(p))) {
-          apex = p;
-          break;
-        }
-      }
-    if (found) {
+    Vec3 apex;
+    if (find_explicit_apex(geo, faces, cells[c], static_cast<Index>(c), cv, apex)) {
       kind[c] = 2;
       apex_of[c] = geo.add_explicit_point(apex);
       continue;
@@ -222,6 +302,129 @@ CellTets tetrahedralize_cells(BspComplex& bsp, const CellLabels& labels) {
     }
   }
   return out;
+}
+
+
+CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels) {
+  ImplicitGeometry& geo = bsp.geometry();
+  const auto& faces = bsp.faces();
+  const auto& cells = bsp.cells();
+  CellTets out;
+  // Face triangulations: the perturbed Delaunay rule, once per face (cell_delaunay.h).
+  std::vector<std::vector<std::array<Index, 3>>> face_tris(faces.size());
+  std::vector<char> done(faces.size(), 0);
+  auto tris_of = [&](Index f) -> const std::vector<std::array<Index, 3>>& {
+    if (!done[f]) {
+      if (faces[f].verts.size() == 3)
+        face_tris[f] = {{faces[f].verts[0], faces[f].verts[1], faces[f].verts[2]}};
+      else
+        face_tris[f] = delaunay_face(geo, faces[f]);
+      done[f] = 1;
+    }
+    return face_tris[f];
+  };
+  auto canonical = [](std::array<Index, 3> t) {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    return t;
+  };
+  // Every vertex of a face lies on the face's plane: recorded, so that predicates on coplanar
+  // points of one facet are decided without arithmetic (ImplicitGeometry::known_coplanar).
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (!cells[c].alive || labels.winding[c] != 1) continue;
+    for (Index f : cells[c].faces)
+      for (Index v : faces[f].verts) geo.note_on_plane(v, faces[f].plane);
+  }
+  CellDelaunay dt;
+  std::vector<std::array<Index, 3>> want;
+  std::vector<Index> cell_planes;
+  std::vector<std::pair<std::array<Index, 3>, Index>> want_planes;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (!cells[c].alive || labels.winding[c] != 1) continue;
+    ++out.inside_cells;
+    const Index ci = static_cast<Index>(c);
+    const std::vector<Index> cv = cell_vertices(faces, cells[c]);
+    if (cv.size() == 4) {
+      out.tets.push_back(tet_cell(faces, cells[c], ci));
+      continue;
+    }
+    // The cell's boundary as its faces triangulate it, outward and canonical.
+    want.clear();
+    for (Index f : cells[c].faces) {
+      const bool positive_side = faces[f].cell[0] == ci;  // n points into the cell
+      for (const auto& t : tris_of(f))
+        want.push_back(canonical(positive_side ? std::array<Index, 3>{t[0], t[2], t[1]} : t));
+    }
+    std::sort(want.begin(), want.end());
+    // Seed of the insertion order: the cell index and its vertex ids (deterministic, local).
+    std::uint64_t seed = 0x243F6A8885A308D3ULL ^ (static_cast<std::uint64_t>(c) * 0x9E3779B97F4A7C15ULL);
+    for (Index v : cv) seed = (seed ^ static_cast<std::uint64_t>(v)) * 0x100000001B3ULL;
+    cell_planes.clear();
+    for (Index f : cells[c].faces) cell_planes.push_back(faces[f].plane);
+    if (delaunay_cell(geo, cv, cell_planes, seed, dt)) {
+      for (auto& t : dt.hull) t = canonical(t);
+      std::sort(dt.hull.begin(), dt.hull.end());
+      if (dt.hull == want) {
+        ++out.delaunay_cells;
+        out.tets.insert(out.tets.end(), dt.tets.begin(), dt.tets.end());
+        continue;
+      }
+      // Some facet made of several faces: recover the faces' triangulations.
+      want_planes.clear();
+      for (Index f : cells[c].faces) {
+        const bool positive_side = faces[f].cell[0] == ci;
+        for (const auto& t : tris_of(f))
+          want_planes.push_back({positive_side ? std::array<Index, 3>{t[0], t[2], t[1]} : t, faces[f].plane});
+      }
+      if (recover_cell_boundary(geo, dt.tets, want_planes, 8)) {
+        ++out.delaunay_cells;
+        ++out.recovered_cells;
+        out.tets.insert(out.tets.end(), dt.tets.begin(), dt.tets.end());
+        continue;
+      }
+    }
+    ++out.delaunay_fallback_cells;
+    // Pulled from a vertex v: every face on a plane through v must already be triangulated by
+    // triangles that all contain v (then it is a fan from v, and the cone from v over the other
+    // faces tiles the cell with positive tets: v is strictly inside their planes' half-spaces).
+    Index pull = -1;
+    for (Index v : cv) {
+      bool ok = true;
+      for (Index f : cells[c].faces) {
+        if (geo.side(faces[f].plane, v) != Sign::kZero) continue;
+        for (const auto& t : tris_of(f))
+          if (t[0] != v && t[1] != v && t[2] != v) {
+            ok = false;
+            break;
+          }
+        if (!ok) break;
+      }
+      if (ok) {
+        pull = v;
+        break;
+      }
+    }
+    if (pull >= 0) {
+      ++out.pulled_cells;
+      cone_cell(geo, faces, cells[c], ci, pull, true, tris_of, out);
+      continue;
+    }
+    Vec3 p;
+    const Index apex =
+        find_explicit_apex(geo, faces, cells[c], ci, cv, p) ? geo.add_explicit_point(p) : implicit_apex(geo, cv);
+    if (apex < 0)
+      throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(c),
+                         "cell " + std::to_string(c) + " has no four non-coplanar vertices");
+    ++out.apex_cells;
+    cone_cell(geo, faces, cells[c], ci, apex, false, tris_of, out);
+  }
+  boundary_faces(faces, labels, tris_of, out);
+  return out;
+}
+
+}  // namespace
+
+CellTets tetrahedralize_cells(BspComplex& bsp, const CellLabels& labels, CellFill fill) {
+  return fill == CellFill::kCone ? tetrahedralize_cells_cone(bsp, labels) : tetrahedralize_cells_delaunay(bsp, labels);
 }
 
 }  // namespace bsptet

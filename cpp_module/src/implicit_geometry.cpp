@@ -59,6 +59,12 @@ T det4_homog(const std::array<T, 4>& r0, const std::array<T, 4>& r1, const std::
          m(r0, r1, 1, 2) * m(r2, r3, 0, 3) - m(r0, r1, 1, 3) * m(r2, r3, 0, 2) + m(r0, r1, 2, 3) * m(r2, r3, 0, 1);
 }
 
+template <class T>
+T det3(const std::array<T, 3>& r0, const std::array<T, 3>& r1, const std::array<T, 3>& r2) {
+  return r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0]) +
+         r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]);
+}
+
 Sign to_sign(int s) { return s > 0 ? Sign::kPositive : (s < 0 ? Sign::kNegative : Sign::kZero); }
 
 }  // namespace
@@ -226,6 +232,20 @@ Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)
     return ::bsptet::orient3d(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
                             points_[vd.explicit_id]);
+  {
+    const auto *ba = box(a), *bb = box(b), *bc = box(c), *bd = box(d);
+    if (ba && bb && bc && bd) {
+      // det[b - a, c - a, d - a] on the coordinate intervals.
+      std::array<Interval, 3> r0, r1, r2;
+      for (int k = 0; k < 3; ++k) {
+        r0[k] = (*bb)[k] - (*ba)[k];
+        r1[k] = (*bc)[k] - (*ba)[k];
+        r2[k] = (*bd)[k] - (*ba)[k];
+      }
+      const int s = det3<Interval>(r0, r1, r2).certain_sign();
+      if (s != 0) return to_sign(s);
+    }
+  }
   // det[[a 1]; [b 1]; [c 1]; [d 1]] = -det[b - a, c - a, d - a]; homogeneous rows scale it by the
   // product of the weights.
   const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c), &hd = vertex_interval(d);
@@ -233,6 +253,10 @@ Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign() * hd[3].certain_sign();
   if (s != 0 && w != 0) return to_sign(-s * w);
   ++exact_fallbacks_;
+  if (known_coplanar(a, b, c, d)) return Sign::kZero;
+  Vec3 pa, pb, pc, pd;
+  if (exact_double(a, &pa) && exact_double(b, &pb) && exact_double(c, &pc) && exact_double(d, &pd))
+    return ::bsptet::orient3d(pa, pb, pc, pd);
   const auto &ea = vertex_exact(a), &eb = vertex_exact(b), &ec = vertex_exact(c), &ed = vertex_exact(d);
   return to_sign(-det4_homog<ExactFloat>(ea, eb, ec, ed).sign() * ea[3].sign() * eb[3].sign() * ec[3].sign() *
                  ed[3].sign());
@@ -243,11 +267,21 @@ Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0)
     return orient2d_projected(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id], axis);
+  {
+    const auto *ba = box(a), *bb = box(b), *bc = box(c);
+    if (ba && bb && bc) {
+      const int s = (((*bb)[u] - (*ba)[u]) * ((*bc)[v] - (*ba)[v]) - ((*bb)[v] - (*ba)[v]) * ((*bc)[u] - (*ba)[u]))
+                        .certain_sign();
+      if (s != 0) return to_sign(s);
+    }
+  }
   const auto &ha = vertex_interval(a), &hb = vertex_interval(b), &hc = vertex_interval(c);
   const int s = det3_homog<Interval>(ha, hb, hc, u, v).certain_sign();
   const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign();
   if (s != 0 && w != 0) return to_sign(s * w);
   ++exact_fallbacks_;
+  Vec3 pa, pb, pc;
+  if (exact_double(a, &pa) && exact_double(b, &pb) && exact_double(c, &pc)) return orient2d_projected(pa, pb, pc, axis);
   const auto &ea = vertex_exact(a), &eb = vertex_exact(b), &ec = vertex_exact(c);
   return to_sign(det3_homog<ExactFloat>(ea, eb, ec, u, v).sign() * ea[3].sign() * eb[3].sign() * ec[3].sign());
 }
@@ -267,6 +301,253 @@ int ImplicitGeometry::projection_axis(Index p, Sign* normal_sign) {
     }
   }
   return -1;
+}
+
+namespace {
+
+
+// Vertex p relative to vertex e, both homogeneous (X, Y, Z, W): D = X_p W_e - X_e W_p (per
+// coordinate) and Q = W_p W_e, so p - e = D / Q.
+template <class T>
+void relative(const std::array<T, 4>& p, const std::array<T, 4>& e, std::array<T, 3>& d, T& q) {
+  for (int k = 0; k < 3; ++k) d[k] = p[k] * e[3] - e[k] * p[3];
+  q = p[3] * e[3];
+}
+
+// Lifted 3D row of p relative to e, scaled by Q^2 > 0: (Dx Q, Dy Q, Dz Q, |D|^2).
+template <class T>
+std::array<T, 4> lifted_row3(const std::array<T, 4>& p, const std::array<T, 4>& e) {
+  std::array<T, 3> d;
+  T q;
+  relative(p, e, d, q);
+  return {d[0] * q, d[1] * q, d[2] * q, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]};
+}
+
+// An interval enclosing each exact entry (to_double truncates: within one ulp).
+template <std::size_t N>
+std::array<Interval, N> enclose(const std::array<ExactFloat, N>& r) {
+  std::array<Interval, N> out;
+  for (std::size_t k = 0; k < N; ++k) {
+    const double d = r[k].to_double();
+    out[k] = r[k].sign() == 0 ? Interval(0.0)
+                              : Interval(std::nextafter(d, -INFINITY), std::nextafter(d, INFINITY));
+  }
+  return out;
+}
+
+// Lifted 2D row of p relative to e, scaled by Q^2 > 0: (Du Q, Dv Q, |D|^2) (3D squared length).
+template <class T>
+std::array<T, 3> lifted_row2(const std::array<T, 4>& p, const std::array<T, 4>& e, int u, int v) {
+  std::array<T, 3> d;
+  T q;
+  relative(p, e, d, q);
+  return {d[u] * q, d[v] * q, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]};
+}
+
+}  // namespace
+
+// The unperturbed determinant: subtracting e's row from the others (x, y, z columns) and
+// |e|^2 - 2 p.e from H (column operations, determinant unchanged) makes e's row (0, 0, 0, 0, 1),
+// so det5 = det4 over the rows a..d of (p - e, |p - e|^2). Each row is then scaled by a positive
+// factor (homogeneous weights), which keeps the sign. Perturbation: det5 is affine in each H_i, with
+// coefficient (-1)^i det4(rows != i; x, y, z, 1) = (-1)^i orient3d(the other four, in order)
+// (det[[p 1]] = -orient3d); minors do not change under the column operations. So when the
+// unperturbed value is zero, the sign is that of the first non-zero coefficient in decreasing
+// vertex id.
+Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) {
+  const std::array<Index, 5> ids{{a, b, c, d, e}};
+  int s0 = 0;
+  const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d), *b4 = box(e);
+  if (b0 && b1 && b2 && b3 && b4) {
+    const std::array<const std::array<Interval, 3>*, 4> rows{{b0, b1, b2, b3}};
+    std::array<std::array<Interval, 4>, 4> r;
+    for (int i = 0; i < 4; ++i) {
+      const Interval dx = (*rows[i])[0] - (*b4)[0], dy = (*rows[i])[1] - (*b4)[1], dz = (*rows[i])[2] - (*b4)[2];
+      r[i] = {dx, dy, dz, dx * dx + dy * dy + dz * dz};
+    }
+    s0 = det4_homog<Interval>(r[0], r[1], r[2], r[3]).certain_sign();
+  } else {
+    const auto& he = vertex_interval(e);
+    const auto r0 = lifted_row3<Interval>(vertex_interval(a), he), r1 = lifted_row3<Interval>(vertex_interval(b), he),
+               r2 = lifted_row3<Interval>(vertex_interval(c), he), r3 = lifted_row3<Interval>(vertex_interval(d), he);
+    s0 = det4_homog<Interval>(r0, r1, r2, r3).certain_sign();
+  }
+  if (s0 == 0) {
+    ++exact_fallbacks_;
+    std::array<Vec3, 5> q;
+    bool dbl = true;
+    for (int i = 0; i < 5 && dbl; ++i) dbl = exact_double(ids[i], &q[i]);
+    if (dbl) {
+      std::array<std::array<ExactFloat, 4>, 4> r;
+      for (int i = 0; i < 4; ++i) {
+        const ExactFloat dx = ExactFloat(q[i].x) - ExactFloat(q[4].x), dy = ExactFloat(q[i].y) - ExactFloat(q[4].y),
+                         dz = ExactFloat(q[i].z) - ExactFloat(q[4].z);
+        r[i] = {dx, dy, dz, dx * dx + dy * dy + dz * dz};
+      }
+      s0 = det4_homog<ExactFloat>(r[0], r[1], r[2], r[3]).sign();
+    } else {
+    const auto& he = vertex_exact(e);
+    const auto r0 = lifted_row3<ExactFloat>(vertex_exact(a), he), r1 = lifted_row3<ExactFloat>(vertex_exact(b), he),
+               r2 = lifted_row3<ExactFloat>(vertex_exact(c), he), r3 = lifted_row3<ExactFloat>(vertex_exact(d), he);
+    // Second filter: the rows are exact (no cancellation left in them), the determinant in intervals.
+    s0 = det4_homog<Interval>(enclose(r0), enclose(r1), enclose(r2), enclose(r3)).certain_sign();
+    if (s0 == 0) s0 = det4_homog<ExactFloat>(r0, r1, r2, r3).sign();
+    }
+  }
+  if (s0 != 0) return to_sign(s0);
+  std::array<int, 5> order{{0, 1, 2, 3, 4}};
+  std::sort(order.begin(), order.end(), [&](int i, int j) { return ids[i] > ids[j]; });
+  for (int i : order) {
+    std::array<Index, 4> o;
+    int n = 0;
+    for (int j = 0; j < 5; ++j)
+      if (j != i) o[n++] = ids[j];
+    const int m = to_int(orient3d(o[0], o[1], o[2], o[3]));
+    if (m != 0) return to_sign(i % 2 == 0 ? m : -m);
+  }
+  return Sign::kZero;
+}
+
+// The same construction one dimension down: det4 over rows (u, v, H, 1) = det3 over the rows a..c
+// of (p - d) projected, |p - d|^2; perturbation coefficient of H_i: (-1)^i orient2d(the other
+// three, in order).
+Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis) {
+  const std::array<Index, 4> ids{{a, b, c, d}};
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  int s0 = 0;
+  const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d);
+  if (b0 && b1 && b2 && b3) {
+    const std::array<const std::array<Interval, 3>*, 3> rows{{b0, b1, b2}};
+    std::array<std::array<Interval, 3>, 3> r;
+    for (int i = 0; i < 3; ++i) {
+      const Interval dd[3] = {(*rows[i])[0] - (*b3)[0], (*rows[i])[1] - (*b3)[1], (*rows[i])[2] - (*b3)[2]};
+      r[i] = {dd[u], dd[v], dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]};
+    }
+    s0 = det3<Interval>(r[0], r[1], r[2]).certain_sign();
+  } else {
+    const auto& hd = vertex_interval(d);
+    s0 = det3<Interval>(lifted_row2<Interval>(vertex_interval(a), hd, u, v),
+                        lifted_row2<Interval>(vertex_interval(b), hd, u, v),
+                        lifted_row2<Interval>(vertex_interval(c), hd, u, v))
+             .certain_sign();
+  }
+  if (s0 == 0) {
+    ++exact_fallbacks_;
+    std::array<Vec3, 4> q;
+    bool dbl = true;
+    for (int i = 0; i < 4 && dbl; ++i) dbl = exact_double(ids[i], &q[i]);
+    if (dbl) {
+      std::array<std::array<ExactFloat, 3>, 3> r;
+      for (int i = 0; i < 3; ++i) {
+        const ExactFloat dx = ExactFloat(q[i].x) - ExactFloat(q[3].x), dy = ExactFloat(q[i].y) - ExactFloat(q[3].y),
+                         dz = ExactFloat(q[i].z) - ExactFloat(q[3].z);
+        const ExactFloat dd[3] = {dx, dy, dz};
+        r[i] = {dd[u], dd[v], dx * dx + dy * dy + dz * dz};
+      }
+      s0 = det3<ExactFloat>(r[0], r[1], r[2]).sign();
+    } else {
+    const auto& hd = vertex_exact(d);
+    const auto r0 = lifted_row2<ExactFloat>(vertex_exact(a), hd, u, v),
+               r1 = lifted_row2<ExactFloat>(vertex_exact(b), hd, u, v),
+               r2 = lifted_row2<ExactFloat>(vertex_exact(c), hd, u, v);
+    s0 = det3<Interval>(enclose(r0), enclose(r1), enclose(r2)).certain_sign();
+    if (s0 == 0) s0 = det3<ExactFloat>(r0, r1, r2).sign();
+    }
+  }
+  if (s0 != 0) return to_sign(s0);
+  std::array<int, 4> order{{0, 1, 2, 3}};
+  std::sort(order.begin(), order.end(), [&](int i, int j) { return ids[i] > ids[j]; });
+  for (int i : order) {
+    std::array<Index, 3> o;
+    int n = 0;
+    for (int j = 0; j < 4; ++j)
+      if (j != i) o[n++] = ids[j];
+    const int m = to_int(orient2d(o[0], o[1], o[2], axis));
+    if (m != 0) return to_sign(i % 2 == 0 ? m : -m);
+  }
+  return Sign::kZero;
+}
+
+const std::array<Interval, 3>* ImplicitGeometry::box(Index v) {
+  Vertex& vx = verts_[v];
+  if (vx.box_state < 0) {
+    vx.box_state = 0;
+    if (vx.explicit_id >= 0) {
+      const Vec3& p = points_[vx.explicit_id];
+      vx.box = {Interval(p.x), Interval(p.y), Interval(p.z)};
+      vx.box_state = 1;
+    } else {
+      const std::array<Interval, 4> h = vertex_interval(v);  // copy: vertex_interval may touch verts_
+      const Interval& w = h[3];
+      if (w.certain_sign() != 0 && std::isfinite(w.lo()) && std::isfinite(w.hi())) {
+        bool ok = true;
+        std::array<Interval, 3> b;
+        for (int k = 0; k < 3 && ok; ++k) {
+          // X / W over the corners; each quotient is rounded to nearest (error <= half an ulp),
+          // so one ulp outward encloses the exact range (W excludes zero: monotone in each).
+          const double q[4] = {h[k].lo() / w.lo(), h[k].lo() / w.hi(), h[k].hi() / w.lo(), h[k].hi() / w.hi()};
+          double lo = q[0], hi = q[0];
+          for (double x : q) {
+            if (!std::isfinite(x)) ok = false;
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+          }
+          b[k] = Interval(std::nextafter(lo, -INFINITY), std::nextafter(hi, INFINITY));
+        }
+        if (ok) {
+          verts_[v].box = b;
+          verts_[v].box_state = 1;
+        }
+      }
+    }
+  }
+  return verts_[v].box_state == 1 ? &verts_[v].box : nullptr;
+}
+
+bool ImplicitGeometry::exact_double(Index v, Vec3* p) {
+  if (verts_[v].explicit_id >= 0) {
+    *p = points_[verts_[v].explicit_id];
+    return true;
+  }
+  if (verts_[v].is_double < 0) {
+    const Vec3 r = rounded(v);
+    const auto& h = vertex_exact(v);
+    const bool exact =
+        ExactFloat(r.x) * h[3] == h[0] && ExactFloat(r.y) * h[3] == h[1] && ExactFloat(r.z) * h[3] == h[2];
+    verts_[v].is_double = exact ? 1 : 0;
+  }
+  if (verts_[v].is_double == 0) return false;
+  *p = verts_[v].rounded;
+  return true;
+}
+
+bool ImplicitGeometry::known_coplanar(Index a, Index b, Index c, Index d) const {
+  auto on = [&](Index v, Index q) {
+    const auto& l = verts_[v].on_planes;
+    return std::find(l.begin(), l.end(), q) != l.end();
+  };
+  for (Index q : verts_[a].on_planes)
+    if (on(b, q) && on(c, q) && on(d, q)) return true;
+  // Three of them on one line are coplanar with any fourth: x, y, z are collinear when x is a TPI
+  // vertex and y, z lie on two of its three defining planes (independent planes: they meet in a
+  // line). This is a vertex a neighbour's split left on an edge, with points of that edge.
+  auto collinear = [&](Index x, Index y, Index z) {
+    const Vertex& vx = verts_[x];
+    if (vx.explicit_id >= 0 || vx.centroid_of[0] >= 0) return false;
+    int common = 0;
+    for (Index q : vx.planes)
+      if (on(y, q) && on(z, q)) ++common;
+    return common >= 2;
+  };
+  const std::array<Index, 4> v{{a, b, c, d}};
+  for (int skip = 0; skip < 4; ++skip) {
+    std::array<Index, 3> t;
+    int n = 0;
+    for (int i = 0; i < 4; ++i)
+      if (i != skip) t[n++] = v[i];
+    if (collinear(t[0], t[1], t[2]) || collinear(t[1], t[2], t[0]) || collinear(t[2], t[0], t[1])) return true;
+  }
+  return false;
 }
 
 Vec3 ImplicitGeometry::rounded(Index v) {

@@ -208,7 +208,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
 
   t0 = Clock::now();
   progress("tetrahedralizing cells", 0);
-  const CellTets cell_tets = tetrahedralize_cells(bsp, labels);
+  const CellTets cell_tets = tetrahedralize_cells(bsp, labels, options.cone_cells ? CellFill::kCone : CellFill::kDelaunay);
   stage_time("cell_tets", t0);
 
   t0 = Clock::now();
@@ -238,6 +238,9 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   st.pushed = ss.pushed;
   st.apex_cells = cell_tets.apex_cells;
   st.pulled_cells = cell_tets.pulled_cells;
+  st.delaunay_cells = cell_tets.delaunay_cells;
+  st.delaunay_recovered_cells = cell_tets.recovered_cells;
+  st.delaunay_fallback_cells = cell_tets.delaunay_fallback_cells;
   st.bsp_nodes = 2 * bsp.stats().splits + 1;
   st.convex_cells = bsp.stats().leaves;
   st.inside_cells = cell_tets.inside_cells;

@@ -1,7 +1,10 @@
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
-//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--reorient] [--write STEM]
+//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient]
+//               [--write STEM]
+//
+// --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
 //
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
 // shells facing the wrong way); --reorient flips triangles as that check allows.
@@ -22,7 +25,9 @@ using namespace bsptet;
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--reorient] [--write STEM]\n",
+    std::fprintf(stderr,
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] "
+                 "[--write STEM]\n",
                  argv[0]);
     return 2;
   }
@@ -32,6 +37,7 @@ int main(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
+    else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
     else {
@@ -46,12 +52,16 @@ int main(int argc, char** argv) {
     const TetMesh m = tetrahedralize(s, o, &st);
     const MeshCheckReport r = check_mesh(s, m);
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
-                "relocated %lld pushed %lld cells %lld inside %lld pulled %lld bsp_points %lld seconds %.3f min_dihedral %.2f\n",
+                "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld (recovered %lld) fallback %lld bsp_points %lld seconds %.3f "
+                "min_dihedral %.2f\n",
                 argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
                 static_cast<long long>(st.boundary_steiner_before_removal), static_cast<long long>(st.collapsed),
                 static_cast<long long>(st.relocated), static_cast<long long>(st.pushed), static_cast<long long>(st.convex_cells),
                 static_cast<long long>(st.inside_cells), static_cast<long long>(st.pulled_cells),
+                static_cast<long long>(st.apex_cells), static_cast<long long>(st.delaunay_cells),
+                static_cast<long long>(st.delaunay_recovered_cells),
+                static_cast<long long>(st.delaunay_fallback_cells),
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg);
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);
     std::printf("\n");

@@ -12,6 +12,7 @@
 //    positively exactly when m[axis] > 0.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
@@ -67,6 +68,29 @@ class ImplicitGeometry {
   /// non-zero), decided exactly; and the sign of that normal component.
   int projection_axis(Index plane, Sign* normal_sign = nullptr);
 
+  /// True when vertex v is known (combinatorially or from an earlier exact zero) to lie on plane p.
+  bool known_on_plane(Index v, Index p) const {
+    const auto& l = verts_[v].on_planes;
+    return std::find(l.begin(), l.end(), p) != l.end();
+  }
+
+  /// Lifted (Delaunay) predicates with symbolic perturbation (cell_delaunay.h uses them).
+  /// Every vertex v is lifted to height H(v) = |v|^2 + eps^k(v), eps -> 0+, where k(v) is strictly
+  /// decreasing in the global vertex id: the vertex with the largest id has the dominant
+  /// perturbation. One global rule, so every caller (both cells of a face, the 2D and the 3D test)
+  /// decides every tie the same way.
+  ///
+  /// lifted_det3(a, b, c, d, e) = sign det [x y z H 1] over the rows a..e (5 x 5). ZERO only when
+  /// the five vertices are coplanar (all its perturbation cofactors vanish). For a positive tet
+  /// (a, b, c, d), e is strictly inside the (perturbed) circumsphere iff the result is NEGATIVE.
+  Sign lifted_det3(Index a, Index b, Index c, Index d, Index e);
+  /// lifted_det2(a, b, c, d, axis) = sign det [u v H 1] over the rows a..d (4 x 4), (u, v) the
+  /// coordinates kept when dropping `axis` (orient2d's convention), H the 3D lift above. For four
+  /// vertices on one plane and orient2d(a, b, c, axis) = s != 0, d is strictly inside the
+  /// (perturbed) circumcircle of a, b, c (in the plane's own metric) iff the result is s.
+  /// ZERO only when the four are collinear in the projection.
+  Sign lifted_det2(Index a, Index b, Index c, Index d, int axis);
+
   /// The coordinates of vertex v rounded to doubles (each coordinate within one ulp).
   Vec3 rounded(Index v);
   /// Counters, for the statistics.
@@ -89,7 +113,19 @@ class ImplicitGeometry {
     std::unique_ptr<std::array<ExactFloat, 4>> exact;
     bool rounded_ready = false;
     Vec3 rounded;  ///< cache of rounded()
+    signed char is_double = -1;  ///< cache of exact_double(): -1 unknown, 0 no, 1 yes
+    signed char box_state = -1;  ///< cache of box(): -1 unknown, 0 unavailable, 1 ready
+    std::array<Interval, 3> box;  ///< intervals enclosing x, y, z (X / W)
   };
+  /// True when vertex v's coordinates are exactly doubles (then *p holds them); decided exactly,
+  /// once per vertex. Lets exact fallbacks on such vertices run on doubles (same signs, cheaper).
+  bool exact_double(Index v, Vec3* p);
+  /// A sufficient condition for coplanarity (no arithmetic): the four vertices are known to lie on
+  /// one plane, or three of them on one line (two defining planes of a TPI vertex).
+  bool known_coplanar(Index a, Index b, Index c, Index d) const;
+  /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
+  /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
+  const std::array<Interval, 3>* box(Index v);
   void prepare_plane(Index p);
   const std::array<ExactFloat, 4>& plane_exact(Index p);
   const std::array<Interval, 4>& vertex_interval(Index v);

@@ -8,7 +8,7 @@
 //   2.1-2.2  BSP tree, convex cells ............ bsp_complex.cpp (conforming cell complex)
 //   2.2.1    BSP points ........................ bsp_complex.cpp (TPI vertices of edge splits)
 //   2.2      inside / outside .................. cell_classify.cpp (exact coverage + winding numbers)
-//   2.3      per-cell tetrahedralization ....... cell_tetrahedralize.cpp
+//   2.3      per-cell tetrahedralization ....... cell_tetrahedralize.cpp, cell_delaunay.cpp (Bowyer-Watson)
 //   2.4/2.5  glue, crossed-edge fixing ......... not needed: the complex is conforming (bsp_complex.h)
 //   (new)    Steiner point removal ............. steiner_removal.cpp (collapse, move off the surface)
 //   output   doubles, checked exactly .......... snap_round.cpp
@@ -27,6 +27,10 @@ struct MeshOptions {
   /// Keep BSP points on the input surface where they are exactly doubles. The default output has
   /// none (FEM loads find nodes on CAD faces): they are collapsed or moved inside.
   bool allow_boundary_steiner = false;
+  /// Fill the inside cells by cones from an apex or a vertex (the filler before the per-cell
+  /// Delaunay, cell_tetrahedralize.h CellFill::kCone) instead of the default per-cell Delaunay
+  /// (paper Sec. 2.3). For comparison.
+  bool cone_cells = false;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;
   /// Called with (stage, fraction in [0, 1]); may be empty.
@@ -41,6 +45,7 @@ struct MeshStats {
   std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
   std::int64_t steiner_before_removal = 0, boundary_steiner_before_removal = 0, collapsed = 0, relocated = 0, pushed = 0;
   std::int64_t apex_cells = 0, pulled_cells = 0;
+  std::int64_t delaunay_cells = 0, delaunay_recovered_cells = 0, delaunay_fallback_cells = 0;  ///< CellTets
   std::int64_t exact_fallbacks = 0;
   std::map<std::string, double> seconds_by_stage;
   double seconds_total = 0;
