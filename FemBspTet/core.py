@@ -383,8 +383,7 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
             min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
-            projection=projection, max_passes=0 if only_order else 40,
-            optimize_rounds=0 if only_order else 8,
+            projection=projection, max_passes=0 if only_order else 40, optimize_rounds=8,
             separate_face_tags=bool(options.get("separate_face_tags")), progress=progress,
             cancel=cancel)
     out = TetMesh(points, tets, mesh.source)

@@ -573,11 +573,12 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
         node_set = set(mesh.tets[e].tolist())
         where = sorted({face_names[g] for f, g in zip(faces.tolist(), tags.tolist())
                         if set(f) <= node_set})
-        flat = ("; the mesh has flat elements there (minimum dihedral angle %.3g degrees), "
-                "thinner than the chord sag, which only the core's quality refinement removes "
-                "(not in this build)" % min_dihedral) if min_dihedral is not None else ""
+        flat = ("; the mesh's worst dihedral angle is %.3g degrees: elements next to the "
+                "curved face are thinner than the distance their mid-nodes move onto it"
+                % min_dihedral) if min_dihedral is not None else ""
         raise InternalError(
             "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
-            "first tet %d%s%s. No mesh was made. ElementOrder 1st meshes this shape (its corner "
-            "nodes are on the CAD faces)"
+            "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
+            "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "
+            "on the CAD faces)"
             % (int(bad.sum()), e, " (at %s)" % ", ".join(where) if where else "", flat))

@@ -288,6 +288,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["flips23"] = st.flips23;
         d["flips32"] = st.flips32;
         d["relocations"] = st.relocations;
+        d["insertions"] = st.insertions;
         d["size_passes"] = st.size_passes;
         d["optimize_rounds"] = st.optimize_rounds;
         d["long_edges_left"] = st.long_edges_left;

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <unordered_map>
 
 #include "bsptet/errors.h"
 #include "bsptet/predicates.h"
@@ -14,6 +15,10 @@
 namespace bsptet {
 
 namespace {
+
+// The face of a tet opposite its vertex k, ordered so that vertex k is on its positive side
+// (types.h: the outward faces reversed).
+constexpr int kOppositeFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
 
 constexpr double kImprovement = 1e-9;  // degrees: a flip or move must raise the worst angle by more
 
@@ -507,10 +512,8 @@ bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double 
 bool RefineMesh::flip23(Index t, int opposite_vertex) {
   if (!tet_alive(t)) return false;
   const auto& q = tet(t);
-  // Faces with the opposite vertex on their positive side (types.h: outward faces reversed).
-  static const int face[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
   const Index a = q[opposite_vertex];
-  const Index x = q[face[opposite_vertex][0]], y = q[face[opposite_vertex][1]], z = q[face[opposite_vertex][2]];
+  const Index x = q[kOppositeFace[opposite_vertex][0]], y = q[kOppositeFace[opposite_vertex][1]], z = q[kOppositeFace[opposite_vertex][2]];
   if (boundary_.count(face_key(x, y, z))) return false;
   Index other = -1, b = -1;
   for (Index s : tets_around_point(x)) {
@@ -569,6 +572,114 @@ bool RefineMesh::flip32(Index u, Index v) {
   for (Index s : shell) kill_tet(s);
   for (const auto& c : created) add_tet(c);
   return true;
+}
+
+Index RefineMesh::neighbour(Index t, int k) {
+  const auto q = tet(t);
+  const Index a = q[kOppositeFace[k][0]], b = q[kOppositeFace[k][1]], c = q[kOppositeFace[k][2]];
+  if (boundary_.count(face_key(a, b, c))) return -1;
+  for (Index n : tets_around_point(a)) {
+    if (n == t) continue;
+    const auto& r = tet(n);
+    const bool hb = r[0] == b || r[1] == b || r[2] == b || r[3] == b;
+    const bool hc = r[0] == c || r[1] == c || r[2] == c || r[3] == c;
+    if (hb && hc) return n;
+  }
+  return -1;
+}
+
+InsertOutcome RefineMesh::insert_point(Index start, const Vec3& p, double clearance, Index* new_point,
+                                       Index max_cavity, bool must_improve) {
+  if (!tet_alive(start)) return InsertOutcome::kWalkFailed;
+  // 1. Locate: step through a face that has p strictly beyond it (the faces are tried from a
+  //    rotating first index so that the walk does not cycle on a fixed choice).
+  Index t = start;
+  bool found = false;
+  for (int step = 0; step < 4096 && !found; ++step) {
+    const auto q = tet(t);
+    int beyond = -1;
+    for (int i = 0; i < 4 && beyond < 0; ++i) {
+      const int k = (i + step) % 4;
+      if (orient3d(point(q[kOppositeFace[k][0]]), point(q[kOppositeFace[k][1]]), point(q[kOppositeFace[k][2]]), p) == Sign::kNegative)
+        beyond = k;
+    }
+    if (beyond < 0) {
+      found = true;
+      break;
+    }
+    const Index n = neighbour(t, beyond);
+    if (n < 0) return InsertOutcome::kOutside;
+    t = n;
+  }
+  if (!found) return InsertOutcome::kWalkFailed;
+  // 2. Cavity: tets whose circumsphere contains p, through interior faces.
+  std::vector<Index> cavity{t};
+  std::unordered_map<Index, char> in{{t, 1}};
+  for (std::size_t i = 0; i < cavity.size() && static_cast<Index>(cavity.size()) < max_cavity; ++i)
+    for (int k = 0; k < 4; ++k) {
+      const Index n = neighbour(cavity[i], k);
+      if (n < 0 || in.count(n)) continue;
+      const auto& r = tet(n);
+      Vec3 c;
+      double r2 = 0;
+      if (!tet_circumsphere(point(r[0]), point(r[1]), point(r[2]), point(r[3]), &c, &r2)) continue;
+      if (squared_distance(c, p) < r2) {
+        in.emplace(n, 1);
+        cavity.push_back(n);
+      }
+    }
+  // 3. Shrink until p sees every boundary face of the cavity strictly from inside (exact).
+  struct BFace {
+    std::array<Index, 3> v;
+    Index owner;
+  };
+  std::vector<BFace> faces;
+  for (;;) {
+    faces.clear();
+    std::vector<Index> drop;
+    for (Index c : cavity) {
+      if (!in[c]) continue;
+      const auto q = tet(c);
+      for (int k = 0; k < 4; ++k) {
+        const Index n = neighbour(c, k);
+        if (n >= 0 && in.count(n) && in[n]) continue;
+        const BFace f{{q[kOppositeFace[k][0]], q[kOppositeFace[k][1]], q[kOppositeFace[k][2]]}, c};
+        if (orient3d(point(f.v[0]), point(f.v[1]), point(f.v[2]), p) != Sign::kPositive) drop.push_back(c);
+        faces.push_back(f);
+      }
+    }
+    if (drop.empty()) break;
+    for (Index c : drop) {
+      if (c == t) return InsertOutcome::kNoStarCavity;
+      in[c] = 0;
+    }
+  }
+  std::vector<Index> kept;
+  for (Index c : cavity)
+    if (in[c]) kept.push_back(c);
+  // 4. No vertex may disappear; clearance.
+  std::vector<Index> on_boundary;
+  for (const BFace& f : faces) on_boundary.insert(on_boundary.end(), f.v.begin(), f.v.end());
+  std::sort(on_boundary.begin(), on_boundary.end());
+  on_boundary.erase(std::unique(on_boundary.begin(), on_boundary.end()), on_boundary.end());
+  for (Index c : kept)
+    for (Index v : tet(c))
+      if (!std::binary_search(on_boundary.begin(), on_boundary.end(), v)) return InsertOutcome::kNoStarCavity;
+  for (Index v : on_boundary)
+    if (squared_distance(point(v), p) < clearance * clearance) return InsertOutcome::kTooClose;
+  if (must_improve) {
+    double old_min = std::numeric_limits<double>::infinity();
+    for (Index c : kept) old_min = std::min(old_min, tet_quality(c));
+    for (const BFace& f : faces)
+      if (tet_min_dihedral_deg(point(f.v[0]), point(f.v[1]), point(f.v[2]), p) <= old_min + kImprovement)
+        return InsertOutcome::kNoImprovement;
+  }
+  // 5. Replace the cavity by the cone from p (every new tet was checked positive in step 3).
+  const Index n = add_point(p, PointSupport{});
+  for (Index c : kept) kill_tet(c);
+  for (const BFace& f : faces) add_tet({f.v[0], f.v[1], f.v[2], n});
+  if (new_point) *new_point = n;
+  return InsertOutcome::kInserted;
 }
 
 bool RefineMesh::relocate_point(Index v, const Vec3& p) {

@@ -44,6 +44,22 @@ double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const V
   return std::acos(std::max(-1.0, std::min(1.0, largest))) * 180.0 / kPi;
 }
 
+bool tet_circumsphere(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3* center, double* radius2) {
+  const V u = sub(b, a), v = sub(c, a), w = sub(d, a);
+  const double det = dot(u, cross(v, w));
+  if (det == 0) return false;
+  const double uu = dot(u, u), vv = dot(v, v), ww = dot(w, w);
+  const V vw = cross(v, w), wu = cross(w, u), uv = cross(u, v);
+  const V off = {(uu * vw.x + vv * wu.x + ww * uv.x) / (2 * det), (uu * vw.y + vv * wu.y + ww * uv.y) / (2 * det),
+                 (uu * vw.z + vv * wu.z + ww * uv.z) / (2 * det)};
+  const double r2 = dot(off, off);
+  const Vec3 p{a.x + off.x, a.y + off.y, a.z + off.z};
+  if (!std::isfinite(r2) || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
+  *center = p;
+  *radius2 = r2;
+  return true;
+}
+
 double tet_radius_edge_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const V u = sub(b, a), v = sub(c, a), w = sub(d, a);
   const double det = dot(u, cross(v, w));

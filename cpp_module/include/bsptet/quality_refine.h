@@ -19,7 +19,11 @@
 //  2. optimization rounds: short edges collapsed (Steiner points only, within their support, never
 //     making the worst tet around worse), 2-3 and 3-2 flips and smoothing of interior points that
 //     raise the smallest dihedral angle locally, tets with a radius-edge ratio above the bound get
-//     their shortest edge collapsed or their longest edge split. Rounds stop when nothing changes
+//     their shortest edge collapsed or their longest edge split, and tets below 15 degrees get a
+//     new interior point where it raises the worst angle of its Bowyer-Watson cavity (candidates:
+//     the apex of a regular tet over each of their faces, circumcentre, centroid; this lifts the
+//     flat tets whose four corners lie on the surface, which no flip can mend). Without a size,
+//     the longest-edge splits of slivers are skipped (they only grew the mesh there). Rounds stop when nothing changes
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
 //  2b. separate_face_tags (optional): see the option;
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
@@ -101,6 +105,7 @@ struct RefineStats {
   std::int64_t splits_rejected = 0;      ///< splits refused (a new tet not positive)
   std::int64_t projection_rejected = 0;  ///< hook results refused (non-finite)
   std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
+  std::int64_t insertions = 0;           ///< interior points inserted where they raise the worst angle
   std::int64_t size_passes = 0, optimize_rounds = 0;
   std::int64_t long_edges_left = 0;      ///< edges still longer than split_ratio * target
   std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split

@@ -71,6 +71,16 @@ enum class SplitOutcome {
   kBadProjection  ///< the projection hook returned a non-finite point
 };
 
+/// What became of an interior point insertion (RefineMesh::insert_point).
+enum class InsertOutcome {
+  kInserted,
+  kOutside,        ///< the walk towards the point met the boundary: it is outside the solid or on it
+  kWalkFailed,     ///< the point was not located within the step limit
+  kTooClose,       ///< a vertex of the cavity is nearer than the asked clearance
+  kNoStarCavity,   ///< no cavity around the point is star-shaped from it (it lies on a mesh face...)
+  kNoImprovement,  ///< must_improve: the cone's worst tet would not be better than the cavity's
+};
+
 /// Kind of a mesh edge with respect to the boundary.
 enum class EdgeKind { kInterior, kInFace, kOnInputEdge };
 
@@ -126,6 +136,22 @@ class RefineMesh {
   bool flip23(Index t, int opposite);
   /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23.
   bool flip32(Index u, Index v);
+  /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
+  /// tet `start` that never crosses a boundary face (kOutside when it would: p is outside the
+  /// solid or on its boundary). The cavity is the tets whose circumsphere contains p (computed in
+  /// doubles: this only SHAPES the cavity), connected to p's tet through interior faces, at most
+  /// `max_cavity` tets; then, exactly, tets are dropped from it until p sees every face of the
+  /// cavity's boundary strictly on its inner side (orient3d > 0), and every vertex of the cavity is
+  /// on that boundary. The cavity is then replaced by the cone from p over its boundary.
+  /// Why this is valid: the cone's tets are all positive, and their signed volumes add up to the
+  /// cavity's (the cone over a closed oriented surface), so they cover every point of the cavity
+  /// exactly once and nothing outside it (winding number 1 inside, 0 outside); no vertex is lost,
+  /// the cavity's boundary faces (the solid's boundary faces among them) are kept as they are.
+  /// kTooClose (nothing changed) when a vertex of the final cavity is closer than `clearance`.
+  /// With `must_improve`, the insertion is applied only when the smallest min dihedral angle of
+  /// the new tets exceeds that of the tets they replace (kNoImprovement otherwise).
+  InsertOutcome insert_point(Index start, const Vec3& p, double clearance, Index* new_point = nullptr,
+                             Index max_cavity = 512, bool must_improve = false);
   /// Moves interior point v to p when every tet around it stays positive and the smallest min
   /// dihedral around it rises.
   bool relocate_point(Index v, const Vec3& p);
@@ -155,6 +181,8 @@ class RefineMesh {
   /// Input triangles whose closed triangle contains point v (by support).
   bool support_allows_collapse(Index from, Index to) const;
   bool edge_exists(Index u, Index v);
+  /// The live tet other than t sharing t's face opposite its vertex k; -1 on the boundary.
+  Index neighbour(Index t, int k);
 
   const SurfaceMesh& surface_;
   ProjectionHook hook_;

@@ -16,6 +16,10 @@ double tet_min_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const V
 /// caps and wedges; infinite for a flat tet.
 double tet_radius_edge_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 
+/// Circumcentre of tet (a, b, c, d) into `center` and the squared circumradius into `radius2`;
+/// false (outputs untouched) for a flat tet or a non-finite result.
+bool tet_circumsphere(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Vec3* center, double* radius2);
+
 /// Squared distance between two points.
 double squared_distance(const Vec3& a, const Vec3& b);
 
