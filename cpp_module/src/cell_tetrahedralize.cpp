@@ -282,25 +282,7 @@ CellTets tetrahedralize_cells_cone(BspComplex& bsp, const CellLabels& labels) {
       }
     }
   }
-  // Boundary faces: between an inside and an outside cell; outward is -n when the inside cell is on
-  // the positive side.
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    const BspFace& face = faces[f];
-    if (!face.alive) continue;
-    const int w0 = face.cell[0] >= 0 ? labels.winding[face.cell[0]] : 0;
-    const int w1 = face.cell[1] >= 0 ? labels.winding[face.cell[1]] : 0;
-    if (w0 == w1) continue;
-    if (face.coplanar.empty() || labels.coverage[f] == 0)
-      throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(f),
-                         "a face between inside and outside is not covered by an input triangle");
-    for (const auto& t : tris_of(static_cast<Index>(f))) {
-      if (w0 == 1)
-        out.boundary.push_back({t[0], t[2], t[1]});
-      else
-        out.boundary.push_back(t);
-      out.boundary_triangle.push_back(face.coplanar[0]);
-    }
-  }
+  boundary_faces(faces, labels, tris_of, out);
   return out;
 }
 
