@@ -118,3 +118,59 @@ def lat_long_sphere(n_lat, n_lon):
             a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
             tris += [(a, c, b), (b, c, d)]
     return np.array(pts), np.array(tris)
+
+
+def tube(outer=1.0, inner=0.8, height=2.0, segments=12):
+    """A closed tube (cylinder with a coaxial cylindrical hole) from z = 0 to z = height: outer
+    wall tag 0, inner wall (concave seen from the solid) tag 1, bottom ring tag 2, top ring tag 3.
+    Outward CCW."""
+    ang = [2 * math.pi * k / segments for k in range(segments)]
+    n = segments
+    pts = []
+    for radius in (outer, inner):
+        for z in (0.0, height):
+            pts += [(radius * math.cos(a), radius * math.sin(a), z) for a in ang]
+    ob, ot, ib, it = 0, n, 2 * n, 3 * n  # first index of each ring
+    tris, tags = [], []
+    for k in range(n):
+        a, b = k, (k + 1) % n
+        tris += [(ob + a, ob + b, ot + b), (ob + a, ot + b, ot + a)]  # outer wall, normal out
+        tags += [0, 0]
+        tris += [(ib + a, it + b, ib + b), (ib + a, it + a, it + b)]  # inner wall, normal to axis
+        tags += [1, 1]
+        tris += [(ob + a, ib + b, ob + b), (ob + a, ib + a, ib + b)]  # bottom ring, normal -z
+        tags += [2, 2]
+        tris += [(ot + a, ot + b, it + b), (ot + a, it + b, it + a)]  # top ring, normal +z
+        tags += [3, 3]
+    return Surface(np.array(pts), np.array(tris), np.array(tags, np.int32), source="tube")
+
+
+def tube_projection(outer, inner, height):
+    def onto(p, tag):
+        p = np.array(p, float)
+        if tag in (0, 1):
+            radius = outer if tag == 0 else inner
+            r = math.hypot(p[0], p[1])
+            p[0], p[1] = p[0] * radius / r, p[1] * radius / r
+        elif tag == 2:
+            p[2] = 0.0
+        elif tag == 3:
+            p[2] = height
+        return p
+
+    def project(point, tag, other_tag):
+        p = onto(point, tag)
+        return onto(p, other_tag) if other_tag >= 0 else p
+    return project
+
+
+def tube_distance(points, outer, inner, height):
+    """Distance of each point to the nearest of the tube's four surfaces, untrimmed (what
+    tube_projection projects onto: a mid-node of a coarse end-ring edge from the outer to the inner
+    circle lies on the plane z = 0 but inside the hole's radius, as on a CAD plane whose
+    tessellation cuts across its trimming circle)."""
+    r = np.hypot(points[:, 0], points[:, 1])
+    z = points[:, 2]
+    walls = np.minimum(np.abs(r - outer), np.abs(r - inner))
+    ends = np.minimum(np.abs(z), np.abs(z - height))
+    return np.minimum(walls, ends)

@@ -296,6 +296,8 @@ PYBIND11_MODULE(_bsptet, m) {
         d["tag_conflicts_left"] = st.tag_conflicts_left;
         d["midnodes_projected"] = st.midnodes_projected;
         d["midnodes_straightened"] = st.midnodes_straightened;
+        d["curving_lifts"] = st.curving_lifts;
+        d["curving_conflicts_left"] = st.curving_conflicts_left;
         d["seconds"] = st.seconds;
         return py::make_tuple(points_array(out), tets_array(out), d);
       },

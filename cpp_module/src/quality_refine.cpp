@@ -60,6 +60,7 @@ class Refiner {
     for (const auto& e : m_.edges())
       if (is_long(e[0], e[1])) ++st_.long_edges_left;
     if (o_.separate_face_tags && !m_.surface().tag.empty()) separate_face_tags();
+    lift_for_curved_elements();
   }
 
  private:
@@ -321,6 +322,163 @@ class Refiner {
       if (done == 0) break;
     }
     st_.tag_conflicts_left = static_cast<std::int64_t>(tag_conflicts().size());
+  }
+
+  // ---- Phase 4: room for curved tet10 elements -----------------------------------------------
+  // With a projection hook and order 2, each boundary mid-node goes onto the true surface, off its
+  // chord by the chord's sag. A tet whose interior apex stands lower over its boundary face than
+  // that sag becomes an invalid curved element (make_second_order would straighten its mid-nodes,
+  // leaving them off the CAD face). Such apexes (interior Steiner points only) are lifted towards
+  // the height of a regular tet over the face, when every tet around stays positive (exact), the
+  // number of invalid curved elements around goes down, and no tet around drops below
+  // min(1 degree, the worst before): a valid curved mesh is worth a worse linear angle there.
+  // Failing that, a new interior point above one of the tet's faces (Bowyer-Watson), accepted when
+  // all its new tets are valid curved elements of at least 1 degree. Splitting the sagging edges
+  // instead was tried and made more invalid elements (docs/quality-stage.md). Sets
+  // curving_conflicts_left.
+  void lift_for_curved_elements() {
+    if (!o_.projection || o_.order != 2) return;
+    static const int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+    static const int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+    std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> tags;
+    for (const auto& [face, parent] : m_.boundary_faces())
+      for (int k = 0; k < 3; ++k) {
+        const Index a = face[k], b = face[(k + 1) % 3];
+        const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+        const std::int32_t tag = m_.tag_of(parent);
+        auto it = tags.find(key);
+        if (it == tags.end())
+          tags.emplace(key, std::array<std::int32_t, 2>{tag, tag});
+        else
+          it->second[1] = tag;
+      }
+    std::map<std::array<Index, 2>, Vec3> projected;  // boundary points never move: a safe cache
+    auto curved_ok = [&](const std::array<Index, 4>& q, const std::array<Vec3, 4>& P) {
+      double x[30];
+      bool curved = false;
+      for (int k = 0; k < 4; ++k) x[3 * k] = P[k].x, x[3 * k + 1] = P[k].y, x[3 * k + 2] = P[k].z;
+      for (int e = 0; e < 6; ++e) {
+        const int i = kEdge[e][0], j = kEdge[e][1];
+        Vec3 mid{0.5 * (P[i].x + P[j].x), 0.5 * (P[i].y + P[j].y), 0.5 * (P[i].z + P[j].z)};
+        const std::array<Index, 2> key{std::min(q[i], q[j]), std::max(q[i], q[j])};
+        auto tg = tags.find(key);
+        if (tg != tags.end()) {
+          auto pr = projected.find(key);
+          if (pr == projected.end()) {
+            const auto tt = tg->second;
+            Vec3 y = o_.projection(mid, tt[0], tt[1] != tt[0] ? tt[1] : -1);
+            if (!std::isfinite(y.x) || !std::isfinite(y.y) || !std::isfinite(y.z)) y = mid;
+            pr = projected.emplace(key, y).first;
+          }
+          curved = curved || squared_distance(pr->second, mid) > 0;
+          mid = pr->second;
+        }
+        x[3 * (4 + e)] = mid.x, x[3 * (4 + e) + 1] = mid.y, x[3 * (4 + e) + 2] = mid.z;
+      }
+      return !curved || tet10_min_jacobian(x) > 0;
+    };
+    auto corners = [&](const std::array<Index, 4>& q) {
+      return std::array<Vec3, 4>{m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3])};
+    };
+    for (int round = 0; round < 6; ++round) {
+      poll("making room for curved tet10 elements", 0.95);
+      std::vector<Index> bad;
+      for (Index t = 0; t < m_.num_tet_slots(); ++t)
+        if (m_.tet_alive(t) && !curved_ok(m_.tet(t), corners(m_.tet(t)))) bad.push_back(t);
+      st_.curving_conflicts_left = static_cast<std::int64_t>(bad.size());
+      if (bad.empty()) return;
+      std::int64_t lifted = 0;
+      for (Index t : bad) {
+        if (!m_.tet_alive(t) || curved_ok(m_.tet(t), corners(m_.tet(t)))) continue;
+        const auto q = m_.tet(t);
+        bool done = false;
+        for (int k = 0; k < 4 && !done; ++k) {
+          const Index d = q[k];
+          if (m_.support(d).kind != Support::kInterior) continue;
+          const Vec3 &A = m_.point(q[kFace[k][0]]), &B = m_.point(q[kFace[k][1]]), &C = m_.point(q[kFace[k][2]]);
+          const Vec3& D = m_.point(d);
+          const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
+          const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
+          double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+          if (!(len > 0)) continue;
+          if ((D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz < 0) nx = -nx, ny = -ny, nz = -nz;
+          const double e = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
+                            std::sqrt(squared_distance(C, A))) / 3;
+          const std::vector<Index> ball = m_.tets_around_point(d);
+          int bad_before = 0;
+          double worst_before = 180;
+          for (Index s2 : ball) {
+            bad_before += !curved_ok(m_.tet(s2), corners(m_.tet(s2)));
+            worst_before = std::min(worst_before, m_.tet_quality(s2));
+          }
+          const double floor_deg = std::min(1.0, worst_before);
+          for (int c = 0; c < 10 && !done; ++c) {
+            const double f = std::array<double, 5>{1.0, 0.75, 0.5, 0.35, 0.25}[static_cast<std::size_t>(c / 2)];
+            const double lambda = c % 2 == 0 ? 1.0 : 0.5;  // all the way, or half way from the apex
+            const double hgt = f * std::sqrt(2.0 / 3.0) * e / len;
+            const Vec3 full{G.x + nx * hgt, G.y + ny * hgt, G.z + nz * hgt};
+            const Vec3 target{D.x + lambda * (full.x - D.x), D.y + lambda * (full.y - D.y), D.z + lambda * (full.z - D.z)};
+            auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+              int bad_after = 0;
+              double w = 180;
+              for (std::size_t i = 0; i < moved.size(); ++i) {
+                const auto& c4 = moved[i];
+                w = std::min(w, tet_min_dihedral_deg(c4[0], c4[1], c4[2], c4[3]));
+                bad_after += !curved_ok(m_.tet(ball[i]), c4);
+              }
+              return w >= floor_deg && bad_after < bad_before;
+            };
+            if (m_.relocate_point_if(d, target, accept)) {
+              ++st_.curving_lifts;
+              ++lifted;
+              done = true;
+            }
+          }
+        }
+        // Else a new interior point above each face of the tet, Bowyer-Watson, accepted when its
+        // new tets are all valid curved elements of at least 1 degree.
+        for (int k = 0; k < 4 && !done; ++k) {
+          const Vec3 &A = m_.point(q[kFace[k][0]]), &B = m_.point(q[kFace[k][1]]), &C = m_.point(q[kFace[k][2]]);
+          const Vec3& D = m_.point(q[k]);
+          const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
+          const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
+          double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+          if (!(len > 0)) continue;
+          if ((D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz < 0) nx = -nx, ny = -ny, nz = -nz;
+          const double e = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
+                            std::sqrt(squared_distance(C, A))) / 3;
+          auto accept = [&](const std::vector<std::array<Index, 4>>& cone, const Vec3& p) {
+            for (const auto& c4 : cone) {
+              const std::array<Vec3, 4> P{m_.point(c4[0]), m_.point(c4[1]), m_.point(c4[2]), p};
+              if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) < 1.0 || !curved_ok(c4, P)) return false;
+            }
+            return true;
+          };
+          // Over the face at the height of a regular tet (or less), then on the segment from the
+          // face's centroid to the opposite corner (thin walls, where the first points fall out).
+          std::vector<Vec3> cand;
+          for (double f : {1.0, 0.5, 0.25}) {
+            const double hgt = f * std::sqrt(2.0 / 3.0) * e / len;
+            cand.push_back({G.x + nx * hgt, G.y + ny * hgt, G.z + nz * hgt});
+          }
+          for (double lambda : {0.5, 0.33, 0.67})
+            cand.push_back({G.x + lambda * (D.x - G.x), G.y + lambda * (D.y - G.y), G.z + lambda * (D.z - G.z)});
+          for (const Vec3& x : cand) {
+            Index np = -1;
+            if (m_.insert_point(t, x, 0.05 * e, &np, 256, false, accept) == InsertOutcome::kInserted) {
+              ++st_.insertions;
+              ++st_.curving_lifts;
+              ++lifted;
+              done = true;
+              break;
+            }
+          }
+        }
+      }
+      if (lifted == 0) return;
+    }
   }
 
   // ---- Phase 2: optimization ------------------------------------------------------------------

@@ -588,8 +588,9 @@ Index RefineMesh::neighbour(Index t, int k) {
   return -1;
 }
 
-InsertOutcome RefineMesh::insert_point(Index start, const Vec3& p, double clearance, Index* new_point,
-                                       Index max_cavity, bool must_improve) {
+InsertOutcome RefineMesh::insert_point(
+    Index start, const Vec3& p, double clearance, Index* new_point, Index max_cavity, bool must_improve,
+    const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>& accept) {
   if (!tet_alive(start)) return InsertOutcome::kWalkFailed;
   // 1. Locate: step through a face that has p strictly beyond it (the faces are tried from a
   //    rotating first index so that the walk does not cycle on a fixed choice).
@@ -674,6 +675,11 @@ InsertOutcome RefineMesh::insert_point(Index start, const Vec3& p, double cleara
       if (tet_min_dihedral_deg(point(f.v[0]), point(f.v[1]), point(f.v[2]), p) <= old_min + kImprovement)
         return InsertOutcome::kNoImprovement;
   }
+  if (accept) {
+    std::vector<std::array<Index, 4>> cone;
+    for (const BFace& f : faces) cone.push_back({f.v[0], f.v[1], f.v[2], -1});
+    if (!accept(cone, p)) return InsertOutcome::kNoImprovement;
+  }
   // 5. Replace the cavity by the cone from p (every new tet was checked positive in step 3).
   const Index n = add_point(p, PointSupport{});
   for (Index c : kept) kill_tet(c);
@@ -698,6 +704,25 @@ bool RefineMesh::relocate_point(Index v, const Vec3& p) {
   }
   xyz_[static_cast<std::size_t>(v)] = p;
   for (std::size_t i = 0; i < ball.size(); ++i) quality_[static_cast<std::size_t>(ball[i])] = q[i];
+  return true;
+}
+
+bool RefineMesh::relocate_point_if(Index v, const Vec3& p,
+                                   const std::function<bool(const std::vector<std::array<Vec3, 4>>&)>& accept) {
+  if (support(v).kind != Support::kInterior || !finite(p)) return false;
+  const std::vector<Index> ball = tets_around_point(v);
+  std::vector<std::array<Vec3, 4>> moved(ball.size());
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const auto& t = tet(ball[i]);
+    if (!positive_with(t, v, p)) return false;
+    for (int k = 0; k < 4; ++k) moved[i][static_cast<std::size_t>(k)] = t[k] == v ? p : point(t[k]);
+  }
+  if (!accept(moved)) return false;
+  xyz_[static_cast<std::size_t>(v)] = p;
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const auto& c = moved[i];
+    quality_[static_cast<std::size_t>(ball[i])] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
+  }
   return true;
 }
 

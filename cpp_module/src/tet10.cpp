@@ -93,8 +93,8 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
       const auto tags = it->second;
       const Vec3 q = hook(p, tags[0], tags[1] != tags[0] ? tags[1] : -1);
       if (std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z)) {
+        curved[i] = q.x != p.x || q.y != p.y || q.z != p.z;  // a straight edge of the surface: 0
         p = q;
-        curved[i] = 1;
         ++st.projected;
       }
     }

@@ -111,6 +111,9 @@ struct RefineStats {
   std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split
   std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
+  std::int64_t curving_lifts = 0;           ///< order 2 with a hook: interior points lifted so that
+                                            ///< curved elements stay valid (quality_refine.cpp)
+  std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element was still invalid
   double seconds = 0;
 };
 

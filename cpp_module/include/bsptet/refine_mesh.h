@@ -150,11 +150,19 @@ class RefineMesh {
   /// kTooClose (nothing changed) when a vertex of the final cavity is closer than `clearance`.
   /// With `must_improve`, the insertion is applied only when the smallest min dihedral angle of
   /// the new tets exceeds that of the tets they replace (kNoImprovement otherwise).
+  /// `accept` (optional) is asked last, with the new tets (the new point as index -1) and p;
+  /// false refuses the insertion (kNoImprovement).
   InsertOutcome insert_point(Index start, const Vec3& p, double clearance, Index* new_point = nullptr,
-                             Index max_cavity = 512, bool must_improve = false);
+                             Index max_cavity = 512, bool must_improve = false,
+                             const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>&
+                                 accept = {});
   /// Moves interior point v to p when every tet around it stays positive and the smallest min
   /// dihedral around it rises.
   bool relocate_point(Index v, const Vec3& p);
+  /// Moves interior point v to p when every tet around it stays positive (exact) and `accept`
+  /// returns true for the moved tets (corner coordinates, in the tets' order, v replaced by p).
+  bool relocate_point_if(Index v, const Vec3& p,
+                         const std::function<bool(const std::vector<std::array<Vec3, 4>>&)>& accept);
 
   // ---- Output ----------------------------------------------------------------------------------
   /// The live tets and the points they use: input points first, at their input indices order kept

@@ -21,7 +21,8 @@ namespace bsptet {
 struct SecondOrderStats {
   std::int64_t midnodes = 0;
   std::int64_t projected = 0;     ///< boundary mid-nodes the hook placed
-  std::int64_t straightened = 0;  ///< of which put back on the chord (a curved tet was not valid)
+  std::int64_t straightened = 0;  ///< of which put back on the chord (a curved tet was not valid;
+                                  ///< only mid-nodes the hook had moved off the chord count)
 };
 
 /// Builds the 10-node mesh of `mesh`'s live tets. `hook` may be empty.
