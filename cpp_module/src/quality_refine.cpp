@@ -20,6 +20,33 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Face (A, B, C) of a tet whose fourth corner is D, for placing points over it.
+struct FaceFrame {
+  Vec3 centroid;
+  Vec3 normal;  ///< unit, towards D
+  double mean_edge = 0;
+  /// The point at `fraction` of a regular tet's height (sqrt(2/3) * mean edge) over the face.
+  Vec3 apex(double fraction) const {
+    const double h = fraction * std::sqrt(2.0 / 3.0) * mean_edge;
+    return {centroid.x + normal.x * h, centroid.y + normal.y * h, centroid.z + normal.z * h};
+  }
+};
+
+// False for a degenerate face.
+bool face_frame(const Vec3& A, const Vec3& B, const Vec3& C, const Vec3& D, FaceFrame* f) {
+  const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
+  const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
+  double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(len > 0) || !std::isfinite(len)) return false;
+  if ((D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz < 0) nx = -nx, ny = -ny, nz = -nz;
+  f->centroid = G;
+  f->normal = {nx / len, ny / len, nz / len};
+  f->mean_edge = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
+                  std::sqrt(squared_distance(C, A))) / 3;
+  return true;
+}
+
 void check_options(const RefineOptions& o) {
   auto bad = [](const std::string& what) { throw InputError(ErrorCode::kBadArgument, "refine", -1, what); };
   if (!(o.size > 0)) bad("size must be a positive length (or infinity for none), got " + std::to_string(o.size));
@@ -395,16 +422,10 @@ class Refiner {
         for (int k = 0; k < 4 && !done; ++k) {
           const Index d = q[k];
           if (m_.support(d).kind != Support::kInterior) continue;
-          const Vec3 &A = m_.point(q[kFace[k][0]]), &B = m_.point(q[kFace[k][1]]), &C = m_.point(q[kFace[k][2]]);
           const Vec3& D = m_.point(d);
-          const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
-          const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
-          double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-          if (!(len > 0)) continue;
-          if ((D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz < 0) nx = -nx, ny = -ny, nz = -nz;
-          const double e = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
-                            std::sqrt(squared_distance(C, A))) / 3;
+          FaceFrame fr;
+          if (!face_frame(m_.point(q[kFace[k][0]]), m_.point(q[kFace[k][1]]), m_.point(q[kFace[k][2]]), D, &fr))
+            continue;
           const std::vector<Index> ball = m_.tets_around_point(d);
           int bad_before = 0;
           double worst_before = 180;
@@ -416,8 +437,7 @@ class Refiner {
           for (int c = 0; c < 10 && !done; ++c) {
             const double f = std::array<double, 5>{1.0, 0.75, 0.5, 0.35, 0.25}[static_cast<std::size_t>(c / 2)];
             const double lambda = c % 2 == 0 ? 1.0 : 0.5;  // all the way, or half way from the apex
-            const double hgt = f * std::sqrt(2.0 / 3.0) * e / len;
-            const Vec3 full{G.x + nx * hgt, G.y + ny * hgt, G.z + nz * hgt};
+            const Vec3 full = fr.apex(f);
             const Vec3 target{D.x + lambda * (full.x - D.x), D.y + lambda * (full.y - D.y), D.z + lambda * (full.z - D.z)};
             auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
               int bad_after = 0;
@@ -439,16 +459,11 @@ class Refiner {
         // Else a new interior point above each face of the tet, Bowyer-Watson, accepted when its
         // new tets are all valid curved elements of at least 1 degree.
         for (int k = 0; k < 4 && !done; ++k) {
-          const Vec3 &A = m_.point(q[kFace[k][0]]), &B = m_.point(q[kFace[k][1]]), &C = m_.point(q[kFace[k][2]]);
           const Vec3& D = m_.point(q[k]);
-          const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
-          const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
-          double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-          const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-          if (!(len > 0)) continue;
-          if ((D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz < 0) nx = -nx, ny = -ny, nz = -nz;
-          const double e = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
-                            std::sqrt(squared_distance(C, A))) / 3;
+          FaceFrame fr;
+          if (!face_frame(m_.point(q[kFace[k][0]]), m_.point(q[kFace[k][1]]), m_.point(q[kFace[k][2]]), D, &fr))
+            continue;
+          const Vec3& G = fr.centroid;
           auto accept = [&](const std::vector<std::array<Index, 4>>& cone, const Vec3& p) {
             for (const auto& c4 : cone) {
               const std::array<Vec3, 4> P{m_.point(c4[0]), m_.point(c4[1]), m_.point(c4[2]), p};
@@ -459,15 +474,12 @@ class Refiner {
           // Over the face at the height of a regular tet (or less), then on the segment from the
           // face's centroid to the opposite corner (thin walls, where the first points fall out).
           std::vector<Vec3> cand;
-          for (double f : {1.0, 0.5, 0.25}) {
-            const double hgt = f * std::sqrt(2.0 / 3.0) * e / len;
-            cand.push_back({G.x + nx * hgt, G.y + ny * hgt, G.z + nz * hgt});
-          }
+          for (double f : {1.0, 0.5, 0.25}) cand.push_back(fr.apex(f));
           for (double lambda : {0.5, 0.33, 0.67})
             cand.push_back({G.x + lambda * (D.x - G.x), G.y + lambda * (D.y - G.y), G.z + lambda * (D.z - G.z)});
           for (const Vec3& x : cand) {
             Index np = -1;
-            if (m_.insert_point(t, x, 0.05 * e, &np, 256, false, accept) == InsertOutcome::kInserted) {
+            if (m_.insert_point(t, x, 0.05 * fr.mean_edge, &np, 256, false, accept) == InsertOutcome::kInserted) {
               ++st_.insertions;
               ++st_.curving_lifts;
               ++lifted;
@@ -653,21 +665,8 @@ class Refiner {
         for (int j = i + 1; j < 4; ++j) mean += length(q[i], q[j]) / 6;
       std::vector<Vec3> cand;
       for (int k = 0; k < 4; ++k) {
-        const Vec3 &A = P[kFace[k][0]], &B = P[kFace[k][1]], &C = P[kFace[k][2]];
-        const Vec3 G{(A.x + B.x + C.x) / 3, (A.y + B.y + C.y) / 3, (A.z + B.z + C.z) / 3};
-        const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, vx = C.x - A.x, vy = C.y - A.y, vz = C.z - A.z;
-        double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-        const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-        if (!(len > 0)) continue;
-        const double e = (std::sqrt(squared_distance(A, B)) + std::sqrt(squared_distance(B, C)) +
-                          std::sqrt(squared_distance(C, A))) / 3;
-        const double h = std::sqrt(2.0 / 3.0) * e / len;
-        const Vec3 x1{G.x - nx * h, G.y - ny * h, G.z - nz * h};
-        const Vec3 x2{G.x + nx * h, G.y + ny * h, G.z + nz * h};
-        // The one on the side of vertex k (the tet's side of the face).
-        const Vec3& D = P[k];
-        const double side = (D.x - G.x) * nx + (D.y - G.y) * ny + (D.z - G.z) * nz;
-        cand.push_back(side >= 0 ? x2 : x1);
+        FaceFrame fr;
+        if (face_frame(P[kFace[k][0]], P[kFace[k][1]], P[kFace[k][2]], P[k], &fr)) cand.push_back(fr.apex(1.0));
       }
       Vec3 cc;
       double r2 = 0;
@@ -710,10 +709,11 @@ class Refiner {
         ++st_.splits;
         set_target(p, 0.5 * (target(a) + target(b)));
         for (int k = 0; k < 3 && smooth_point(p); ++k) ++st_.relocations;
-        return true;
+        ++n;
+        break;
       }
     }
-    return false;
+    return n;
   }
 
   // Tets worse than the bound: their shortest edge collapsed (if it helps), else their longest
