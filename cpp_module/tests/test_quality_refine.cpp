@@ -99,6 +99,60 @@ TEST(RefineMesh, NoExactPointOnAGenericEdgeInExactMode) {
   EXPECT_FALSE(check_mesh(s, rounded.to_tet_mesh()).valid);
 }
 
+TEST(RefineMesh, InsertPointFillsItsCavityExactlyAndRespectsItsAcceptance) {
+  SurfaceMesh s;
+  TetMesh m;
+  bipyramid(s, m);
+  RefineMesh r(s, m);
+  const Vec3 inside{1.2, 1.2, 0.1}, outside{5, 5, 0};
+  // Outside the solid: the walk meets the boundary, nothing changes.
+  EXPECT_EQ(r.insert_point(0, outside, 0), InsertOutcome::kOutside);
+  EXPECT_EQ(r.num_alive_tets(), 2);
+  // Refused by the acceptance hook: nothing changes; it saw the cone (new point as -1).
+  std::size_t seen = 0;
+  auto refuse = [&](const std::vector<std::array<Index, 4>>& cone, const Vec3& p) {
+    seen = cone.size();
+    for (const auto& t : cone) EXPECT_EQ(t[3], -1);
+    EXPECT_EQ(p.z, inside.z);
+    return false;
+  };
+  EXPECT_EQ(r.insert_point(0, inside, 0, nullptr, 512, false, refuse), InsertOutcome::kNoImprovement);
+  EXPECT_EQ(seen, 6u);  // both tets in the cavity: the cone over the 6 surface triangles
+  EXPECT_EQ(r.num_alive_tets(), 2);
+  // Accepted: 6 positive tets, the mesh valid against the input, the point interior.
+  Index n = -1;
+  ASSERT_EQ(r.insert_point(0, inside, 0, &n), InsertOutcome::kInserted);
+  EXPECT_EQ(r.num_alive_tets(), 6);
+  EXPECT_EQ(r.support(n).kind, Support::kInterior);
+  const MeshCheckReport rep = check_mesh(s, r.to_tet_mesh());
+  EXPECT_TRUE(rep.valid);
+  EXPECT_EQ(rep.boundary_steiner_points, 0);
+  // The walk starts from a live tet (tet 0 is gone); too close to an existing vertex: refused.
+  EXPECT_EQ(r.insert_point(0, {1.2, 1.2, 0.11}, 0.5), InsertOutcome::kWalkFailed);
+  Index live = 0;
+  while (!r.tet_alive(live)) ++live;
+  EXPECT_EQ(r.insert_point(live, {1.2, 1.2, 0.11}, 0.5), InsertOutcome::kTooClose);
+  EXPECT_EQ(r.num_alive_tets(), 6);
+}
+
+TEST(RefineMesh, RelocateIfMovesOnlyInteriorPointsToValidPlacesItsHookAccepts) {
+  SurfaceMesh s;
+  TetMesh m;
+  bipyramid(s, m);
+  RefineMesh r(s, m);
+  Index n = -1;
+  ASSERT_EQ(r.insert_point(0, {1.2, 1.2, 0.1}, 0, &n), InsertOutcome::kInserted);
+  auto yes = [](const std::vector<std::array<Vec3, 4>>&) { return true; };
+  auto no = [](const std::vector<std::array<Vec3, 4>>&) { return false; };
+  EXPECT_FALSE(r.relocate_point_if(0, {0.1, 0.1, 0}, yes));      // an input point never moves
+  EXPECT_FALSE(r.relocate_point_if(n, {1.3, 1.3, 0.0}, no));      // refused by the hook
+  EXPECT_FALSE(r.relocate_point_if(n, {3.0, 3.0, 0.0}, yes));     // outside the solid: not positive
+  EXPECT_EQ(r.point(n).x, 1.2);
+  EXPECT_TRUE(r.relocate_point_if(n, {1.3, 1.3, 0.0}, yes));
+  EXPECT_EQ(r.point(n).x, 1.3);
+  EXPECT_TRUE(check_mesh(s, r.to_tet_mesh()).valid);
+}
+
 TEST(QualityRefine, BoxWithHoleToSizeIsValidAndBetterShaped) {
   const SurfaceMesh s = read_off(data("paper/box_with_hole.off"));
   const TetMesh core = tetrahedralize(s);
