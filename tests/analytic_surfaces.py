@@ -81,6 +81,13 @@ def cylinder_projection(radius, height):
             p[2] = height
         return p
 
+    return two_tag_projection(onto)
+
+
+def two_tag_projection(onto):
+    """The core's hook (point, tag, other_tag) from ``onto(point, tag)``: onto the tag's surface,
+    then, on an edge between two tags, onto the other's (their common curve, for the surfaces
+    here: a cylinder and a plane perpendicular to its axis)."""
     def project(point, tag, other_tag):
         p = onto(point, tag)
         return onto(p, other_tag) if other_tag >= 0 else p
@@ -158,10 +165,7 @@ def tube_projection(outer, inner, height):
             p[2] = height
         return p
 
-    def project(point, tag, other_tag):
-        p = onto(point, tag)
-        return onto(p, other_tag) if other_tag >= 0 else p
-    return project
+    return two_tag_projection(onto)
 
 
 def tube_distance(points, outer, inner, height):
