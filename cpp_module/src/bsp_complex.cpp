@@ -153,6 +153,7 @@ void BspComplex::split_edge(Index u, Index w, Index x) {
   if (it == edge_faces_.end()) return;
   const std::vector<Index> users = it->second;  // copy: registration changes the map
   for (Index g : users) {
+    geo_.note_on_plane(x, faces_[g].plane);  // x is on the edge, so on every face using it
     unregister_edges(g);
     auto& v = faces_[g].verts;
     const std::size_t n = v.size();
@@ -454,7 +455,184 @@ Index BspComplex::edge_plane(Index a, Index b, Index face_plane) {
   throw MeshingError(ErrorCode::kInternal, "bsp", a, "no box corner off a face plane");
 }
 
+bool BspComplex::segment_crosses_face(Index f, Index a, Index b, int axis, int fo) {
+  // Separating lines in the plane: the segment's own line (the face on one closed side), or an
+  // edge line of the face (both ends on its closed outer side). Neither exists iff the closed
+  // segment meets the open face.
+  const auto& fv = faces_[f].verts;
+  bool pos = false, neg = false;
+  for (Index y : fv) {
+    const Sign s = geo_.orient2d(a, b, y, axis);
+    pos = pos || s == Sign::kPositive;
+    neg = neg || s == Sign::kNegative;
+  }
+  if (!pos || !neg) return false;
+  for (std::size_t i = 0; i < fv.size(); ++i) {
+    const Index u = fv[i], w = fv[(i + 1) % fv.size()];
+    if (fo * to_int(geo_.orient2d(u, w, a, axis)) <= 0 && fo * to_int(geo_.orient2d(u, w, b, axis)) <= 0)
+      return false;
+  }
+  return true;
+}
+
+void BspComplex::replace_face(Index f, std::vector<BspFace> pieces) {
+  const BspFace old = faces_[f];
+  unregister_edges(f);
+  faces_[f].alive = false;
+  std::vector<Index> ids;
+  for (auto& piece : pieces) ids.push_back(new_face(std::move(piece)));
+  for (int side = 0; side < 2; ++side) {
+    const Index c = old.cell[side];
+    if (c < 0) continue;
+    auto& fl = cells_[c].faces;
+    auto it = std::find(fl.begin(), fl.end(), f);
+    if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
+    *it = ids[0];
+    fl.insert(fl.end(), ids.begin() + 1, ids.end());
+  }
+}
+
+void BspComplex::overlay_covered_face(Index f, const std::vector<Index>& over, int axis, int fo) {
+  const Index plane = faces_[f].plane;
+  // Triangle t's vertices counter-clockwise around the plane normal (as the face's cycle).
+  auto ccw = [&](Index t) {
+    std::array<Index, 3> tv{triangle_vertex(t, 0), triangle_vertex(t, 1), triangle_vertex(t, 2)};
+    if (to_int(geo_.orient2d(tv[0], tv[1], tv[2], axis)) != fo) std::swap(tv[1], tv[2]);
+    return tv;
+  };
+  // 1. Every point where an edge of a covering triangle meets an edge of f becomes a vertex of f
+  // (for every face using that edge: conformity). Input vertices on f's edges are used as they are.
+  for (Index t : over) {
+    const std::array<Index, 3> tv = ccw(t);
+    for (int k = 0; k < 3; ++k) {
+      const Index a = tv[k], b = tv[(k + 1) % 3];
+      for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
+        const auto& v = faces_[f].verts;
+        const Index u = v[i], w = v[(i + 1) % v.size()];
+        if (to_int(geo_.orient2d(a, b, u, axis)) * to_int(geo_.orient2d(a, b, w, axis)) >= 0) continue;
+        const int sa = to_int(geo_.orient2d(u, w, a, axis)), sb = to_int(geo_.orient2d(u, w, b, axis));
+        if (sa == 0 || sb == 0) {
+          const Index y = sa == 0 ? a : b;
+          for (Index q : edge_line(u, w)) geo_.note_on_plane(y, q);
+          split_edge(u, w, y);
+        } else if (sa * sb < 0) {
+          const std::array<Index, 2> line = edge_line(u, w);
+          const Index x = geo_.add_tpi_vertex(line[0], line[1], edge_plane(a, b, plane));
+          ++stats_.bsp_points;
+          split_edge(u, w, x);
+        }
+      }
+    }
+  }
+  // 2. The pieces f ∩ t, walked counter-clockwise: the runs of f's cycle inside closed t, joined
+  // along t's edges through t's vertices strictly inside f.
+  const std::vector<Index> cyc = faces_[f].verts;
+  const std::size_t m = cyc.size();
+  std::vector<BspFace> pieces;
+  for (Index t : over) {
+    const std::array<Index, 3> tv = ccw(t);
+    std::vector<char> in(m);
+    bool any_in = false, all_in = true;
+    for (std::size_t i = 0; i < m; ++i) {
+      bool inside = true;
+      for (int k = 0; k < 3 && inside; ++k) inside = fo * to_int(geo_.orient2d(tv[k], tv[(k + 1) % 3], cyc[i], axis)) >= 0;
+      in[i] = inside;
+      any_in = any_in || inside;
+      all_in = all_in && inside;
+    }
+    bool inner[3];
+    for (int j = 0; j < 3; ++j) {
+      inner[j] = true;
+      for (std::size_t i = 0; i < m && inner[j]; ++i)
+        inner[j] = fo * to_int(geo_.orient2d(cyc[i], cyc[(i + 1) % m], tv[j], axis)) > 0;
+    }
+    BspFace piece;
+    piece.plane = plane;
+    piece.cell[0] = faces_[f].cell[0];
+    piece.cell[1] = faces_[f].cell[1];
+    piece.coplanar = {t};
+    if (all_in) {
+      piece.verts = cyc;
+    } else if (!any_in) {
+      if (!inner[0] || !inner[1] || !inner[2])
+        throw MeshingError(ErrorCode::kInternal, "bsp", f, "covering triangle " + std::to_string(t) + " not inside its face");
+      piece.verts.assign(tv.begin(), tv.end());
+    } else {
+      std::size_t i0 = m;
+      for (std::size_t i = 0; i < m && i0 == m; ++i)
+        if (in[i] && !in[(i + m - 1) % m]) i0 = i;
+      std::size_t i = i0;
+      do {
+        piece.verts.push_back(cyc[i]);
+        const std::size_t nx = (i + 1) % m;
+        if (in[nx]) {
+          i = nx;
+          continue;
+        }
+        // Leaving t at cyc[i]: follow t's boundary from the edge through it, in t's direction.
+        const Index x = cyc[i];
+        int on[3], count = 0;
+        for (int k = 0; k < 3; ++k) {
+          on[k] = geo_.orient2d(tv[k], tv[(k + 1) % 3], x, axis) == Sign::kZero;
+          count += on[k];
+        }
+        int kx = -1;
+        if (count == 1) {
+          for (int k = 0; k < 3; ++k)
+            if (on[k]) kx = k;
+        } else if (count == 2) {
+          for (int k = 0; k < 3; ++k)
+            if (on[k] && on[(k + 2) % 3]) kx = k;  // x is tv[k]: leave along edge k
+        }
+        if (kx < 0)
+          throw MeshingError(ErrorCode::kInternal, "bsp", f,
+                             "face edge leaves covering triangle " + std::to_string(t) + " at no vertex");
+        for (int j = (kx + 1) % 3, steps = 0; steps < 3 && inner[j]; j = (j + 1) % 3, ++steps) piece.verts.push_back(tv[j]);
+        i = nx;
+        while (!in[i]) i = (i + 1) % m;
+      } while (i != i0);
+    }
+    // The piece must be a convex polygon, counter-clockwise.
+    const std::size_t n = piece.verts.size();
+    int corners = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const int o = fo * to_int(geo_.orient2d(piece.verts[k], piece.verts[(k + 1) % n], piece.verts[(k + 2) % n], axis));
+      if (o < 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "a covered piece is not convex");
+      corners += o > 0;
+    }
+    if (n < 3 || corners < 3) throw MeshingError(ErrorCode::kInternal, "bsp", f, "a covered piece is degenerate");
+    // Lines of the new edges: along an edge of t.
+    for (std::size_t k = 0; k < n; ++k) {
+      const Index p = piece.verts[k], q = piece.verts[(k + 1) % n];
+      if (edge_line_.count(edge_key(p, q))) continue;
+      Index along = -1;
+      for (int e = 0; e < 3 && along < 0; ++e)
+        if (geo_.orient2d(tv[e], tv[(e + 1) % 3], p, axis) == Sign::kZero &&
+            geo_.orient2d(tv[e], tv[(e + 1) % 3], q, axis) == Sign::kZero)
+          along = edge_plane(tv[e], tv[(e + 1) % 3], plane);
+      if (along < 0) throw MeshingError(ErrorCode::kInternal, "bsp", f, "a covered piece's edge is on no line");
+      edge_line_[edge_key(p, q)] = {plane, along};
+    }
+    pieces.push_back(std::move(piece));
+  }
+  replace_face(f, std::move(pieces));
+}
+
 void BspComplex::refine_covered_faces() {
+  // The input triangle across each input edge, to tell the edges where the surface leaves a plane
+  // (patch boundaries) from those between two triangles of the same plane.
+  std::unordered_map<std::uint64_t, std::array<Index, 2>> edge_tris;
+  for (Index t = 0; t < surface_.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      auto& e = edge_tris.try_emplace(edge_key(triangle_vertex(t, k), triangle_vertex(t, (k + 1) % 3)),
+                                      std::array<Index, 2>{-1, -1}).first->second;
+      (e[0] < 0 ? e[0] : e[1]) = t;
+    }
+  auto patch_boundary = [&](Index t, int k) {
+    const auto& e = edge_tris.at(edge_key(triangle_vertex(t, k), triangle_vertex(t, (k + 1) % 3)));
+    const Index other = e[0] == t ? e[1] : e[0];
+    return other < 0 || tri_plane_[other] != tri_plane_[t];
+  };
   std::vector<Index> work;
   for (std::size_t f = 0; f < faces_.size(); ++f)
     if (faces_[f].alive && !faces_[f].coplanar.empty()) work.push_back(static_cast<Index>(f));
@@ -465,49 +643,49 @@ void BspComplex::refine_covered_faces() {
     Sign ns = Sign::kZero;
     const int axis = geo_.projection_axis(faces_[f].plane, &ns);
     const int fo = to_int(ns);
-    Index cover = -1;
+    std::vector<Index> over;
     for (Index t : faces_[f].coplanar)
-      if (face_overlaps_triangle(f, t, axis, fo)) {
-        cover = t;
-        break;
-      }
-    if (cover < 0) {
+      if (face_overlaps_triangle(f, t, axis, fo)) over.push_back(t);
+    if (over.empty()) {
       faces_[f].coplanar.clear();
       continue;
     }
-    // Contained in the covering triangle? Otherwise split along an edge of it that crosses f.
-    const Index tv[3] = {triangle_vertex(cover, 0), triangle_vertex(cover, 1), triangle_vertex(cover, 2)};
-    const int to = to_int(geo_.orient2d(tv[0], tv[1], tv[2], axis));
-    int cut_edge = -1;
-    for (int k = 0; k < 3 && cut_edge < 0; ++k) {
-      bool in = false, out = false;
-      for (Index y : faces_[f].verts) {
-        const int s = to * to_int(geo_.orient2d(tv[k], tv[(k + 1) % 3], y, axis));
-        in = in || s > 0;
-        out = out || s < 0;
+    // Where the plane's part of the surface ends inside f, split f along that edge's line: then
+    // each half is covered entirely or not at all, whatever the triangles inside it.
+    Index cut_a = -1, cut_b = -1;
+    for (std::size_t j = 0; j < over.size() && cut_a < 0; ++j)
+      for (int k = 0; k < 3 && cut_a < 0; ++k) {
+        if (!patch_boundary(over[j], k)) continue;
+        const Index a = triangle_vertex(over[j], k), b = triangle_vertex(over[j], (k + 1) % 3);
+        if (segment_crosses_face(f, a, b, axis, fo)) cut_a = a, cut_b = b;
       }
-      if (in && out) cut_edge = k;
-    }
-    if (cut_edge < 0) {
-      faces_[f].coplanar = {cover};
+    if (cut_a >= 0) {
+      const Index q = edge_plane(cut_a, cut_b, faces_[f].plane);
+      std::map<Index, int> sign;
+      for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
+      cut_crossing_edges(f, q, sign);
+      const auto [i0, i1] = split_face(f, q, sign);
+      for (int side = 0; side < 2; ++side) {
+        const Index c = faces_[i0].cell[side];
+        if (c < 0) continue;
+        auto& fl = cells_[c].faces;
+        auto it = std::find(fl.begin(), fl.end(), f);
+        if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
+        *it = i0;
+        fl.push_back(i1);
+      }
+      work.push_back(i1);
+      work.push_back(i0);
+      if (debug_checks_) check_consistency();
       continue;
     }
-    const Index q = edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane);
-    std::map<Index, int> sign;
-    for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
-    cut_crossing_edges(f, q, sign);
-    const auto [i0, i1] = split_face(f, q, sign);
-    for (int side = 0; side < 2; ++side) {
-      const Index c = faces_[i0].cell[side];
-      if (c < 0) continue;
-      auto& fl = cells_[c].faces;
-      auto it = std::find(fl.begin(), fl.end(), f);
-      if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
-      *it = i0;
-      fl.push_back(i1);
+    // f lies in the union of the triangles it overlaps (no patch boundary crosses its interior):
+    // one face per triangle, f ∩ t.
+    if (over.size() == 1) {
+      faces_[f].coplanar = over;
+      continue;
     }
-    work.push_back(i1);
-    work.push_back(i0);
+    overlay_covered_face(f, over, axis, fo);
     if (debug_checks_) check_consistency();
   }
 }

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "bsptet/cell_tetrahedralize.h"
+#include "bsptet/errors.h"
 
 namespace bsptet {
 
@@ -33,29 +34,63 @@ std::vector<std::array<Index, 3>> delaunay_face(ImplicitGeometry& geo, const Bsp
   // flips, every edge is locally regular and the triangulation is the perturbed regular one (all
   // points are vertices of their lifted hull). The cap only guards against a bug; the result is a
   // valid triangulation either way, and it is computed once per face.
-  const std::size_t cap = 8 * tris.size() * tris.size() + 64;
-  for (std::size_t round = 0; round < cap; ++round) {
-    // Directed edge -> (triangle, position), sorted.
+  // Neighbours: nb[t][k] is the triangle across edge (tris[t][k], tris[t][k + 1]), or -1 on the
+  // face's boundary. Built once from the sorted directed edges, then kept up to date by each flip.
+  const std::size_t m = tris.size();
+  std::vector<std::array<std::ptrdiff_t, 3>> nb(m, {-1, -1, -1});
+  {
     std::vector<std::pair<std::pair<Index, Index>, std::pair<std::size_t, int>>> edge;
-    for (std::size_t t = 0; t < tris.size(); ++t)
+    edge.reserve(3 * m);
+    for (std::size_t t = 0; t < m; ++t)
       for (int k = 0; k < 3; ++k) edge.push_back({{tris[t][k], tris[t][(k + 1) % 3]}, {t, k}});
     std::sort(edge.begin(), edge.end());
-    bool flipped = false;
-    for (std::size_t t = 0; t < tris.size() && !flipped; ++t)
-      for (int k = 0; k < 3 && !flipped; ++k) {
-        const Index a = tris[t][k], b = tris[t][(k + 1) % 3], c = tris[t][(k + 2) % 3];
-        const auto it = std::lower_bound(edge.begin(), edge.end(),
-                                         std::make_pair(std::make_pair(b, a), std::make_pair(std::size_t(0), 0)));
-        if (it == edge.end() || it->first != std::make_pair(b, a) || it->second.first < t) continue;
-        const std::size_t u = it->second.first;
-        const Index d = tris[u][(it->second.second + 2) % 3];
-        if (geo.lifted_det2(a, b, c, d, axis) != ns) continue;
-        if (geo.orient2d(a, d, c, axis) != ns || geo.orient2d(d, b, c, axis) != ns) continue;
-        tris[t] = {a, d, c};
-        tris[u] = {d, b, c};
-        flipped = true;
-      }
-    if (!flipped) break;
+    for (const auto& e : edge) {
+      const auto it = std::lower_bound(
+          edge.begin(), edge.end(),
+          std::make_pair(std::make_pair(e.first.second, e.first.first), std::make_pair(std::size_t(0), 0)));
+      if (it != edge.end() && it->first == std::make_pair(e.first.second, e.first.first))
+        nb[e.second.first][e.second.second] = static_cast<std::ptrdiff_t>(it->second.first);
+    }
+  }
+  // Position in triangle t of the directed edge (a, b).
+  auto position = [&](std::size_t t, Index a, Index b) {
+    for (int k = 0; k < 3; ++k)
+      if (tris[t][k] == a && tris[t][(k + 1) % 3] == b) return k;
+    throw MeshingError(ErrorCode::kInternal, "delaunay_face", face.plane, "neighbour lost its shared edge");
+  };
+  // Lawson's stack: every edge once at the start, then the four outer edges of each flip. The
+  // order is fixed (deterministic); the result does not depend on it (it is the unique perturbed
+  // regular triangulation). The flip count guards only against a bug.
+  std::vector<std::pair<std::size_t, int>> stack;
+  stack.reserve(3 * m);
+  for (std::size_t t = m; t-- > 0;)
+    for (int k = 3; k-- > 0;) stack.push_back({t, k});
+  const std::size_t cap = 8 * m * m + 64;
+  std::size_t flips = 0;
+  while (!stack.empty() && flips < cap) {
+    const auto [t, k] = stack.back();
+    stack.pop_back();
+    const std::ptrdiff_t us = nb[t][k];
+    if (us < 0) continue;
+    const std::size_t u = static_cast<std::size_t>(us);
+    const Index a = tris[t][k], b = tris[t][(k + 1) % 3], c = tris[t][(k + 2) % 3];
+    const int j = position(u, b, a);
+    const Index d = tris[u][(j + 2) % 3];
+    if (geo.lifted_det2(a, b, c, d, axis) != ns) continue;
+    if (geo.orient2d(a, d, c, axis) != ns || geo.orient2d(d, b, c, axis) != ns) continue;
+    const std::ptrdiff_t x_bc = nb[t][(k + 1) % 3], x_ca = nb[t][(k + 2) % 3];
+    const std::ptrdiff_t y_ad = nb[u][(j + 1) % 3], y_db = nb[u][(j + 2) % 3];
+    tris[t] = {a, d, c};
+    tris[u] = {d, b, c};
+    nb[t] = {y_ad, static_cast<std::ptrdiff_t>(u), x_ca};
+    nb[u] = {y_db, x_bc, static_cast<std::ptrdiff_t>(t)};
+    if (x_bc >= 0) nb[x_bc][position(x_bc, c, b)] = static_cast<std::ptrdiff_t>(u);
+    if (y_ad >= 0) nb[y_ad][position(y_ad, d, a)] = static_cast<std::ptrdiff_t>(t);
+    stack.push_back({t, 0});
+    stack.push_back({t, 2});
+    stack.push_back({u, 0});
+    stack.push_back({u, 1});
+    ++flips;
   }
   return tris;
 }

@@ -36,42 +36,44 @@ mpq_class ExactFloat::to_mpq() const {
   return q;
 }
 
-namespace {
-// Aligns two numbers to the smaller exponent: returns mantissas scaled so that both share `e`.
-void align(const mpz_class& am, std::int64_t ae, const mpz_class& bm, std::int64_t be, mpz_class& ra,
-           mpz_class& rb, std::int64_t& e) {
-  if (ae == be) {
-    ra = am;
-    rb = bm;
-    e = ae;
-  } else if (ae > be) {
-    mpz_mul_2exp(ra.get_mpz_t(), am.get_mpz_t(), static_cast<mp_bitcnt_t>(ae - be));
-    rb = bm;
-    e = be;
+// Sum or difference without temporaries: the operand with the larger exponent is shifted into the
+// result's mantissa, then the other is added or subtracted in place (one allocation at most).
+ExactFloat add_or_subtract(const ExactFloat& a, const ExactFloat& b, bool subtract) {
+  ExactFloat r;
+  mpz_ptr rm = r.mant_.get_mpz_t();
+  mpz_srcptr am = a.mant_.get_mpz_t(), bm = b.mant_.get_mpz_t();
+  if (a.exp_ == b.exp_) {
+    subtract ? mpz_sub(rm, am, bm) : mpz_add(rm, am, bm);
+    r.exp_ = a.exp_;
+  } else if (a.exp_ > b.exp_) {
+    mpz_mul_2exp(rm, am, static_cast<mp_bitcnt_t>(a.exp_ - b.exp_));
+    subtract ? mpz_sub(rm, rm, bm) : mpz_add(rm, rm, bm);
+    r.exp_ = b.exp_;
   } else {
-    ra = am;
-    mpz_mul_2exp(rb.get_mpz_t(), bm.get_mpz_t(), static_cast<mp_bitcnt_t>(be - ae));
-    e = ae;
+    mpz_mul_2exp(rm, bm, static_cast<mp_bitcnt_t>(b.exp_ - a.exp_));
+    subtract ? mpz_sub(rm, am, rm) : mpz_add(rm, am, rm);
+    r.exp_ = a.exp_;
   }
+  return r;
 }
-}  // namespace
 
 ExactFloat operator+(const ExactFloat& a, const ExactFloat& b) {
   if (a.mant_ == 0) return b;
   if (b.mant_ == 0) return a;
-  ExactFloat r;
-  mpz_class x, y;
-  align(a.mant_, a.exp_, b.mant_, b.exp_, x, y, r.exp_);
-  r.mant_ = x + y;
-  return r;
+  return add_or_subtract(a, b, false);
 }
 
-ExactFloat operator-(const ExactFloat& a, const ExactFloat& b) { return a + (-b); }
+ExactFloat operator-(const ExactFloat& a, const ExactFloat& b) {
+  if (b.mant_ == 0) return a;
+  if (a.mant_ == 0) return -b;
+  return add_or_subtract(a, b, true);
+}
 
 ExactFloat operator*(const ExactFloat& a, const ExactFloat& b) {
   ExactFloat r;
-  r.mant_ = a.mant_ * b.mant_;
-  r.exp_ = (r.mant_ == 0) ? 0 : a.exp_ + b.exp_;
+  if (a.mant_ == 0 || b.mant_ == 0) return r;
+  mpz_mul(r.mant_.get_mpz_t(), a.mant_.get_mpz_t(), b.mant_.get_mpz_t());
+  r.exp_ = a.exp_ + b.exp_;
   return r;
 }
 

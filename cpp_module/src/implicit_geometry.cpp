@@ -279,6 +279,7 @@ Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
   const int s = det3_homog<Interval>(ha, hb, hc, u, v).certain_sign();
   const int w = ha[3].certain_sign() * hb[3].certain_sign() * hc[3].certain_sign();
   if (s != 0 && w != 0) return to_sign(s * w);
+  if (known_collinear(a, b, c)) return Sign::kZero;
   ++exact_fallbacks_;
   Vec3 pa, pb, pc;
   if (exact_double(a, &pa) && exact_double(b, &pb) && exact_double(c, &pc)) return orient2d_projected(pa, pb, pc, axis);
@@ -521,6 +522,25 @@ bool ImplicitGeometry::exact_double(Index v, Vec3* p) {
   return true;
 }
 
+bool ImplicitGeometry::known_collinear(Index x, Index y, Index z) const {
+  // x, y, z are collinear when x is a TPI vertex and y, z lie on two of its three defining planes
+  // (independent planes: they meet in a line). This is a vertex a split left on an edge, with
+  // points of that edge.
+  auto on = [&](Index v, Index q) {
+    const auto& l = verts_[v].on_planes;
+    return std::find(l.begin(), l.end(), q) != l.end();
+  };
+  auto through = [&](Index t, Index u, Index w) {
+    const Vertex& vt = verts_[t];
+    if (vt.explicit_id >= 0 || vt.centroid_of[0] >= 0) return false;
+    int common = 0;
+    for (Index q : vt.planes)
+      if (on(u, q) && on(w, q)) ++common;
+    return common >= 2;
+  };
+  return through(x, y, z) || through(y, z, x) || through(z, x, y);
+}
+
 bool ImplicitGeometry::known_coplanar(Index a, Index b, Index c, Index d) const {
   auto on = [&](Index v, Index q) {
     const auto& l = verts_[v].on_planes;
@@ -528,26 +548,8 @@ bool ImplicitGeometry::known_coplanar(Index a, Index b, Index c, Index d) const 
   };
   for (Index q : verts_[a].on_planes)
     if (on(b, q) && on(c, q) && on(d, q)) return true;
-  // Three of them on one line are coplanar with any fourth: x, y, z are collinear when x is a TPI
-  // vertex and y, z lie on two of its three defining planes (independent planes: they meet in a
-  // line). This is a vertex a neighbour's split left on an edge, with points of that edge.
-  auto collinear = [&](Index x, Index y, Index z) {
-    const Vertex& vx = verts_[x];
-    if (vx.explicit_id >= 0 || vx.centroid_of[0] >= 0) return false;
-    int common = 0;
-    for (Index q : vx.planes)
-      if (on(y, q) && on(z, q)) ++common;
-    return common >= 2;
-  };
-  const std::array<Index, 4> v{{a, b, c, d}};
-  for (int skip = 0; skip < 4; ++skip) {
-    std::array<Index, 3> t;
-    int n = 0;
-    for (int i = 0; i < 4; ++i)
-      if (i != skip) t[n++] = v[i];
-    if (collinear(t[0], t[1], t[2]) || collinear(t[1], t[2], t[0]) || collinear(t[2], t[0], t[1])) return true;
-  }
-  return false;
+  // Three of them on one line are coplanar with any fourth.
+  return known_collinear(b, c, d) || known_collinear(a, c, d) || known_collinear(a, b, d) || known_collinear(a, b, c);
 }
 
 Vec3 ImplicitGeometry::rounded(Index v) {

@@ -2,8 +2,9 @@
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
 //   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient]
-//               [--write STEM]
+//               [--progress] [--write STEM]
 //
+// --progress: print each stage and its percentage to stderr as it goes.
 // --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
 //
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] "
-                 "[--write STEM]\n",
+                 "[--progress] [--write STEM]\n",
                  argv[0]);
     return 2;
   }
@@ -39,6 +40,15 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
     else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
+    else if (!std::strcmp(argv[i], "--progress"))
+      o.progress = [](const std::string& stage, double f) {
+        static std::string last;
+        static int last_pct = -1;
+        const int pct = static_cast<int>(f * 100);
+        if (stage != last || pct != last_pct) std::fprintf(stderr, "[%s %d%%]\n", stage.c_str(), pct);
+        last = stage;
+        last_pct = pct;
+      };
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);

@@ -70,8 +70,16 @@ class BspComplex {
   void identify_input_vertices(Index first = 0);
 
   /// After build(): splits every face that lies on an input plane until each one is inside a single
-  /// input triangle (or overlaps none). The covering triangle is then face.coplanar[0]. Splits run
-  /// along input edge lines inside the plane, for every face that uses the crossed edges.
+  /// input triangle (or overlaps none). The covering triangle is then face.coplanar[0]. Two steps:
+  ///  1. Where the plane's part of the surface ends inside a face (an edge of a covering triangle
+  ///     whose other triangle is on another plane meets the face's interior), the face is split
+  ///     along that edge's line, for every face that uses the crossed edges. Then each face is
+  ///     either covered entirely by the plane's triangles or not at all.
+  ///  2. A covered face that overlaps several triangles is replaced by the convex pieces f ∩ t,
+  ///     one per triangle: the points where the triangles' edges meet the face's edges become
+  ///     vertices (of every face using those edges). Unlike splitting along whole edge lines (an
+  ///     arrangement of lines: O(k^2) points for k triangles in a face), this adds only where
+  ///     input edges actually cross the face's boundary.
   void refine_covered_faces();
 
   const std::vector<BspFace>& faces() const { return faces_; }
@@ -113,6 +121,14 @@ class BspComplex {
   /// Exact: does the interior of face f overlap the interior of coplanar input triangle t?
   bool face_overlaps_triangle(Index f, Index t, int axis, int face_orientation);
   Index edge_plane(Index a, Index b, Index face_plane);
+  /// Exact: does closed input segment (a, b), in f's plane, meet the interior of face f?
+  bool segment_crosses_face(Index f, Index a, Index b, int axis, int face_orientation);
+  /// Replaces face f by `pieces` (same plane and cells) in both of its cells.
+  void replace_face(Index f, std::vector<BspFace> pieces);
+  /// f lies in the union of the coplanar input triangles `over` (each overlapping it): makes every
+  /// crossing of their edges with f's edges a vertex (conformity), then replaces f by the convex
+  /// pieces f ∩ t, one per triangle.
+  void overlay_covered_face(Index f, const std::vector<Index>& over, int axis, int face_orientation);
   std::unordered_map<std::uint64_t, Index> edge_planes_;
 
   ImplicitGeometry& geo_;

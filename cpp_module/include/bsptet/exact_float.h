@@ -35,6 +35,7 @@ class ExactFloat {
   friend bool operator!=(const ExactFloat& a, const ExactFloat& b) { return !(a == b); }
 
  private:
+  friend ExactFloat add_or_subtract(const ExactFloat& a, const ExactFloat& b, bool subtract);
   mpz_class mant_;
   std::int64_t exp_;
 };

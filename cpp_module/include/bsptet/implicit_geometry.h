@@ -123,6 +123,9 @@ class ImplicitGeometry {
   /// A sufficient condition for coplanarity (no arithmetic): the four vertices are known to lie on
   /// one plane, or three of them on one line (two defining planes of a TPI vertex).
   bool known_coplanar(Index a, Index b, Index c, Index d) const;
+  /// A sufficient condition for collinearity (no arithmetic): one of them is a TPI vertex and the
+  /// other two lie on two of its defining planes.
+  bool known_collinear(Index x, Index y, Index z) const;
   /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
   /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
   const std::array<Interval, 3>* box(Index v);
