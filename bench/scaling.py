@@ -346,7 +346,24 @@ def exponent_text(x, y, minimum=3):
     return f"{fit_exponent(x, y)[0]:.2f} ({len(x)} points)"
 
 
-def exponents(rows, families, meshers):
+def local_slopes(rows, family, mesher, timeout):
+    """Slopes of log(wall seconds) between consecutive sizes, as text; after a finished size, a
+    timeout gives a lower bound (">x": the run took more than ``timeout``)."""
+    rr = sorted((r for r in rows if r["family"] == family and r["mesher"] == mesher),
+                key=lambda r: r["triangles"])
+    out = []
+    for a, b in zip(rr, rr[1:]):
+        if a["status"] != "ok" or b["triangles"] == a["triangles"]:
+            continue
+        dx = math.log(b["triangles"] / a["triangles"])
+        if b["status"] == "ok":
+            out.append(f"{math.log(max(b['seconds'], 1e-3) / max(a['seconds'], 1e-3)) / dx:.2f}")
+        elif b["status"] == "timeout":
+            out.append(f">{math.log(timeout / max(a['seconds'], 1e-3)) / dx:.2f}")
+    return ", ".join(out) or "-"
+
+
+def exponents(rows, families, meshers, timeout=None):
     """``{(family, mesher): {"time": text, "cpu": text, "memory": text, "time_top3": ...}}``."""
     out = {}
     for fam in families:
@@ -365,6 +382,7 @@ def exponents(rows, families, meshers):
                  "memory": exponent_text(tri, mb)}
             e["time_top3"] = exponent_text(tri[-3:], sec[-3:]) if len(done) > 3 else "-"
             e["memory_top3"] = exponent_text(tri[-3:], mb[-3:]) if len(done) > 3 else "-"
+            e["local"] = local_slopes(rows, fam, mesher, timeout) if timeout else "-"
             out[(fam, mesher)] = e
     return out
 
@@ -421,9 +439,9 @@ def md_table(heads, body):
 
 def exponent_table(exps):
     heads = ["family", "mesher", "time exponent", "CPU-time exponent", "memory exponent",
-             "time, largest 3", "memory, largest 3"]
+             "time, largest 3", "memory, largest 3", "local time slopes"]
     body = [[fam, COMMANDS.get(m, "ours"), e["time"], e["cpu"], e["memory"], e["time_top3"],
-             e["memory_top3"]] for (fam, m), e in exps.items()]
+             e["memory_top3"], e.get("local", "-")] for (fam, m), e in exps.items()]
     return heads, body
 
 
@@ -525,7 +543,9 @@ def main(argv=None):
     ap.add_argument("--note", action="append", default=[],
                     help="a line added to the markdown report (repeatable)")
     args = ap.parse_args(argv)
-    command = "bench/scaling.py " + " ".join(sys.argv[1:] if argv is None else argv)
+    import shlex
+
+    command = "bench/scaling.py " + shlex.join(sys.argv[1:] if argv is None else argv)
 
     families = [f for f in args.families.split(",") if f]
     meshers = [m for m in args.meshers.split(",") if m]
@@ -643,7 +663,7 @@ def write_outputs(args, command, families, meshers, inputs, rows, notes, elapsed
     if env is None:
         env = [(k, v) for k, v in environment() if k != "Gmsh"] + _ours_environment(args)
     heads, body = table_rows(inputs, rows)
-    exps = exponents(rows, families, meshers)
+    exps = exponents(rows, families, meshers, args.timeout)
     eh, eb = exponent_table(exps)
     print()
     print(text_table(heads, body))
@@ -689,6 +709,8 @@ def _ours_environment(args):
 
 
 def report_markdown(command, args, inputs, heads, body, eh, eb, notes, elapsed, env):
+    if " --note " in command:  # the notes are printed below, not in the command
+        command = command[:command.index(" --note ")] + " --note ..."
     lines = ["# Scaling: FemBspTet's core beside TetGen, 10^3 to 10^6 input triangles", "",
              f"Made by `{command}` in {elapsed / 60:.1f} min.", "",
              "| machine and versions | |", "|---|---|"]
@@ -714,7 +736,10 @@ def report_markdown(command, args, inputs, heads, body, eh, eb, notes, elapsed, 
               "log(peak MB)) against "
               "log(triangles) over the finished sizes; with fewer than 3 finished sizes it is "
               "not fitted. Start-up and fixed costs flatten the small sizes, so the slope over "
-              "the largest 3 sizes is given too.",
+              "the largest 3 sizes is given too. Runs that timed out are left out of the fits, "
+              "which biases a mesher's exponent low when its larger sizes timed out: the local "
+              "slopes (between consecutive sizes, wall time) show it, a timeout after a finished "
+              "size giving a lower bound (\">x\").",
               "", "## Inputs", "",
               "| input | triangles | points | how | made in s |", "|---|---|---|---|---|"]
     lines += [f"| {i['name']} | {i['triangles']} | {i['points']} | {i['note']} | "

@@ -120,3 +120,11 @@ def test_exponents_use_finished_runs_only():
     assert e["time"].startswith("1.50 ") and e["cpu"].startswith("1.50 ")
     assert e["memory"].startswith("1.00 ")
     assert math.isclose(float(e["time"].split()[0]), 1.5)
+
+
+def test_local_slopes_and_timeout_bound():
+    rows = [{"family": "torus", "mesher": S.OURS, "triangles": t, "status": st, "seconds": sec}
+            for t, st, sec in ((1000, "ok", 1.0), (10000, "ok", 100.0), (100000, "timeout", 300.0),
+                               (1000000, "not run", None))]
+    text = S.local_slopes(rows, "torus", S.OURS, timeout=1000.0)
+    assert text == "2.00, >1.00"
