@@ -168,7 +168,7 @@ void BspComplex::split_edge(Index u, Index w, Index x) {
   }
 }
 
-void BspComplex::cut_crossing_edges(Index f, Index q, std::map<Index, int>& sign) {
+void BspComplex::cut_crossing_edges(Index f, Index q, VertexSigns& sign) {
   for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
     const auto& v = faces_[f].verts;
     const Index a = v[i], b = v[(i + 1) % v.size()];
@@ -182,7 +182,7 @@ void BspComplex::cut_crossing_edges(Index f, Index q, std::map<Index, int>& sign
   }
 }
 
-std::array<Index, 2> BspComplex::split_face(Index f, Index q, std::map<Index, int>& sign) {
+std::array<Index, 2> BspComplex::split_face(Index f, Index q, VertexSigns& sign) {
   // The face is convex and q crosses its interior: exactly two zero vertices bound the runs of
   // positive and negative vertices. Returns {positive half, negative half}; f dies.
   const std::vector<Index> v = faces_[f].verts;
@@ -230,7 +230,7 @@ std::array<Index, 2> BspComplex::split_face(Index f, Index q, std::map<Index, in
 
 bool BspComplex::split_cell(Index c, Index p) {
   // 1. Classify the cell's vertices.
-  std::map<Index, int> sign;
+  VertexSigns sign;
   for (Index f : cells_[c].faces)
     for (Index v : faces_[f].verts)
       if (!sign.count(v)) sign[v] = to_int(geo_.side(p, v));
@@ -661,7 +661,7 @@ void BspComplex::refine_covered_faces() {
       }
     if (cut_a >= 0) {
       const Index q = edge_plane(cut_a, cut_b, faces_[f].plane);
-      std::map<Index, int> sign;
+      VertexSigns sign;
       for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
       cut_crossing_edges(f, q, sign);
       const auto [i0, i1] = split_face(f, q, sign);

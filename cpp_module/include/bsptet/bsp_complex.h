@@ -28,6 +28,9 @@
 
 namespace bsptet {
 
+/// Side of a splitting plane per vertex (-1, 0, +1); only looked up, never iterated in order.
+using VertexSigns = std::unordered_map<Index, int>;
+
 struct BspFace {
   Index plane = -1;
   std::vector<Index> verts;     ///< cyclic, CCW around the plane normal
@@ -111,9 +114,9 @@ class BspComplex {
   bool split_cell(Index c, Index p);
   /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),
   /// inserting the new vertex into every face that uses the edge.
-  void cut_crossing_edges(Index f, Index q, std::map<Index, int>& sign);
+  void cut_crossing_edges(Index f, Index q, VertexSigns& sign);
   /// Splits face f by plane q (`sign`: side of each of f's vertices, crossing edges already cut).
-  std::array<Index, 2> split_face(Index f, Index q, std::map<Index, int>& sign);
+  std::array<Index, 2> split_face(Index f, Index q, VertexSigns& sign);
   void split_edge(Index u, Index w, Index x);
   /// The two distinct planes whose intersection is the line of edge (u, w).
   std::array<Index, 2> edge_line(Index u, Index w) const;
