@@ -230,15 +230,17 @@ std::array<Index, 2> BspComplex::split_face(Index f, Index q, VertexSigns& sign)
 
 bool BspComplex::split_cell(Index c, Index p) {
   // 1. Classify the cell's vertices.
-  VertexSigns sign;
+  VertexSigns& sign = signs_;
+  sign.reset();
+  bool pos = false, neg = false;
   for (Index f : cells_[c].faces)
     for (Index v : faces_[f].verts)
-      if (!sign.count(v)) sign[v] = to_int(geo_.side(p, v));
-  bool pos = false, neg = false;
-  for (const auto& [v, s] : sign) {
-    pos = pos || s > 0;
-    neg = neg || s < 0;
-  }
+      if (!sign.count(v)) {
+        const int s = to_int(geo_.side(p, v));
+        sign[v] = s;
+        pos = pos || s > 0;
+        neg = neg || s < 0;
+      }
   if (!pos || !neg) return false;
 
   // 2. Cut the crossing edges (for every face that uses them: conformity).
@@ -661,7 +663,8 @@ void BspComplex::refine_covered_faces() {
       }
     if (cut_a >= 0) {
       const Index q = edge_plane(cut_a, cut_b, faces_[f].plane);
-      VertexSigns sign;
+      VertexSigns& sign = signs_;
+      sign.reset();
       for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
       cut_crossing_edges(f, q, sign);
       const auto [i0, i1] = split_face(f, q, sign);

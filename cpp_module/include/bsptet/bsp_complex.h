@@ -16,6 +16,7 @@
 // negative side; -1 means outside the bounding box.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -28,8 +29,35 @@
 
 namespace bsptet {
 
-/// Side of a splitting plane per vertex (-1, 0, +1); only looked up, never iterated in order.
-using VertexSigns = std::unordered_map<Index, int>;
+/// Side of one splitting plane per vertex (-1, 0, +1; 0 for a vertex not set since reset()):
+/// a flat array over vertex ids with a generation stamp, so a reset costs nothing.
+class VertexSigns {
+ public:
+  void reset() {
+    if (++stamp_ == 0) {
+      std::fill(set_.begin(), set_.end(), 0u);
+      stamp_ = 1;
+    }
+  }
+  bool count(Index v) const { return static_cast<std::size_t>(v) < set_.size() && set_[v] == stamp_; }
+  int& operator[](Index v) {
+    if (static_cast<std::size_t>(v) >= set_.size()) {
+      const std::size_t n = std::max<std::size_t>(static_cast<std::size_t>(v) + 1, 2 * set_.size());
+      set_.resize(n, 0u);
+      value_.resize(n, 0);
+    }
+    if (set_[v] != stamp_) {
+      set_[v] = stamp_;
+      value_[v] = 0;
+    }
+    return value_[v];
+  }
+
+ private:
+  std::vector<std::uint32_t> set_;
+  std::vector<int> value_;
+  std::uint32_t stamp_ = 1;
+};
 
 struct BspFace {
   Index plane = -1;
@@ -133,6 +161,7 @@ class BspComplex {
   /// pieces f ∩ t, one per triangle.
   void overlay_covered_face(Index f, const std::vector<Index>& over, int axis, int face_orientation);
   std::unordered_map<std::uint64_t, Index> edge_planes_;
+  VertexSigns signs_;  ///< scratch for split_cell and refine_covered_faces (reset by each)
 
   ImplicitGeometry& geo_;
   const SurfaceMesh& surface_;
