@@ -174,6 +174,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["collapsed"] = st.collapsed;
         d["relocated"] = st.relocated;
         d["exact_fallbacks"] = st.exact_fallbacks;
+        d["retried_along_lines"] = st.retried_along_lines;
         d["delaunay_cells"] = st.delaunay_cells;
         d["delaunay_recovered_cells"] = st.delaunay_recovered_cells;
         d["delaunay_fallback_cells"] = st.delaunay_fallback_cells;

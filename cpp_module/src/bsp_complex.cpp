@@ -693,6 +693,65 @@ void BspComplex::refine_covered_faces() {
   }
 }
 
+void BspComplex::refine_covered_faces_along_lines() {
+  std::vector<Index> work;
+  for (std::size_t f = 0; f < faces_.size(); ++f)
+    if (faces_[f].alive && !faces_[f].coplanar.empty()) work.push_back(static_cast<Index>(f));
+  std::reverse(work.begin(), work.end());
+  while (!work.empty()) {
+    const Index f = work.back();
+    work.pop_back();
+    Sign ns = Sign::kZero;
+    const int axis = geo_.projection_axis(faces_[f].plane, &ns);
+    const int fo = to_int(ns);
+    Index cover = -1;
+    for (Index t : faces_[f].coplanar)
+      if (face_overlaps_triangle(f, t, axis, fo)) {
+        cover = t;
+        break;
+      }
+    if (cover < 0) {
+      faces_[f].coplanar.clear();
+      continue;
+    }
+    // Contained in the covering triangle? Otherwise split along an edge of it that crosses f.
+    const Index tv[3] = {triangle_vertex(cover, 0), triangle_vertex(cover, 1), triangle_vertex(cover, 2)};
+    const int to = to_int(geo_.orient2d(tv[0], tv[1], tv[2], axis));
+    int cut_edge = -1;
+    for (int k = 0; k < 3 && cut_edge < 0; ++k) {
+      bool in = false, out = false;
+      for (Index y : faces_[f].verts) {
+        const int s = to * to_int(geo_.orient2d(tv[k], tv[(k + 1) % 3], y, axis));
+        in = in || s > 0;
+        out = out || s < 0;
+      }
+      if (in && out) cut_edge = k;
+    }
+    if (cut_edge < 0) {
+      faces_[f].coplanar = {cover};
+      continue;
+    }
+    const Index q = edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane);
+    VertexSigns& sign = signs_;
+    sign.reset();
+    for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
+    cut_crossing_edges(f, q, sign);
+    const auto [i0, i1] = split_face(f, q, sign);
+    for (int side = 0; side < 2; ++side) {
+      const Index c = faces_[i0].cell[side];
+      if (c < 0) continue;
+      auto& fl = cells_[c].faces;
+      auto it = std::find(fl.begin(), fl.end(), f);
+      if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
+      *it = i0;
+      fl.push_back(i1);
+    }
+    work.push_back(i1);
+    work.push_back(i0);
+    if (debug_checks_) check_consistency();
+  }
+}
+
 void BspComplex::check_consistency() const {
   for (std::size_t c = 0; c < cells_.size(); ++c) {
     for (Index f : cells_[c].faces) {

@@ -160,7 +160,7 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
 
 void validate_surface(const SurfaceMesh& s) { validated_surface(s); }
 
-TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
   const auto t_start = Clock::now();
   MeshStats st;
   auto stage_time = [&](const char* name, Clock::time_point since) {
@@ -197,7 +197,10 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   bsp.build(options.cancelled, [&](double f) { progress("BSP tree", f); });
   bsp.identify_input_vertices();
   const Index before_refinement = geo.num_vertices();
-  bsp.refine_covered_faces();
+  if (options.covered_faces_along_lines)
+    bsp.refine_covered_faces_along_lines();
+  else
+    bsp.refine_covered_faces();
   bsp.identify_input_vertices(before_refinement);
   stage_time("bsp", t0);
 
@@ -249,6 +252,29 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   st.seconds_total = std::chrono::duration<double>(Clock::now() - t_start).count();
   if (stats) *stats = st;
   return mesh;
+}
+
+TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+  const auto t_start = Clock::now();
+  try {
+    return tetrahedralize_once(input, options, stats);
+  } catch (const MeshingError& e) {
+    // The Steiner removal can get stuck on a surface point it cannot move inside; the other
+    // refinement of the covered faces gives another complex (other points) and usually goes
+    // through. Anything else (bad input, cancelled, other stages) is reported as it is.
+    if (options.covered_faces_along_lines || e.code() != ErrorCode::kInternal || e.stage() != "steiner") throw;
+    MeshOptions again = options;
+    again.covered_faces_along_lines = true;
+    if (options.progress) options.progress("retrying: " + std::string(e.what()), 0);
+    MeshStats st;
+    TetMesh mesh = tetrahedralize_once(input, again, &st);
+    st.retried_along_lines = 1;
+    const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
+    st.seconds_by_stage["first_run"] = total - st.seconds_total;
+    st.seconds_total = total;
+    if (stats) *stats = st;
+    return mesh;
+  }
 }
 
 }  // namespace bsptet

@@ -1,9 +1,11 @@
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
-//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient]
+//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--reorient]
 //               [--progress] [--write STEM]
 //
+// --along-lines: refine the faces on input planes along whole input edge lines (the fallback
+//   tetrahedralize() uses by itself when the Steiner removal gets stuck).
 // --progress: print each stage and its percentage to stderr as it goes.
 // --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
 //
@@ -27,7 +29,7 @@ using namespace bsptet;
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--reorient] "
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--reorient] "
                  "[--progress] [--write STEM]\n",
                  argv[0]);
     return 2;
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
     else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
+    else if (!std::strcmp(argv[i], "--along-lines")) o.covered_faces_along_lines = true;
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--progress"))
       o.progress = [](const std::string& stage, double f) {
@@ -63,7 +66,7 @@ int main(int argc, char** argv) {
     const MeshCheckReport r = check_mesh(s, m);
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
                 "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld (recovered %lld) fallback %lld bsp_points %lld seconds %.3f "
-                "min_dihedral %.2f\n",
+                "min_dihedral %.2f%s\n",
                 argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
                 static_cast<long long>(st.boundary_steiner_before_removal), static_cast<long long>(st.collapsed),
@@ -72,7 +75,8 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.apex_cells), static_cast<long long>(st.delaunay_cells),
                 static_cast<long long>(st.delaunay_recovered_cells),
                 static_cast<long long>(st.delaunay_fallback_cells),
-                static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg);
+                static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg,
+                st.retried_along_lines ? " (retried along lines)" : "");
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);
     std::printf("\n");
     for (const auto& msg : r.messages) std::printf("  %s\n", msg.c_str());

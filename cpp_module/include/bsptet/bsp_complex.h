@@ -112,6 +112,11 @@ class BspComplex {
   ///     arrangement of lines: O(k^2) points for k triangles in a face), this adds only where
   ///     input edges actually cross the face's boundary.
   void refine_covered_faces();
+  /// The earlier refinement, kept as the fallback of tetrahedralize (mesher.h): every covered face
+  /// split along the line of an edge of its covering triangle until it lies in one triangle (an
+  /// arrangement of lines: many more points on planes with many triangles, but a different
+  /// complex when the Steiner removal gets stuck on the first one).
+  void refine_covered_faces_along_lines();
 
   const std::vector<BspFace>& faces() const { return faces_; }
   const std::vector<BspCell>& cells() const { return cells_; }

@@ -31,6 +31,10 @@ struct MeshOptions {
   /// Delaunay, cell_tetrahedralize.h CellFill::kCone) instead of the default per-cell Delaunay
   /// (paper Sec. 2.3). For comparison.
   bool cone_cells = false;
+  /// Refine the faces on input planes along whole input edge lines (the refinement before session
+  /// 6; bsp_complex.h refine_covered_faces_along_lines) instead of one piece per input triangle.
+  /// tetrahedralize() retries with it by itself when the Steiner removal gets stuck.
+  bool covered_faces_along_lines = false;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;
   /// Called with (stage, fraction in [0, 1]); may be empty.
@@ -47,6 +51,9 @@ struct MeshStats {
   std::int64_t apex_cells = 0, pulled_cells = 0;
   std::int64_t delaunay_cells = 0, delaunay_recovered_cells = 0, delaunay_fallback_cells = 0;  ///< CellTets
   std::int64_t exact_fallbacks = 0;
+  /// 1 when the first run's Steiner removal got stuck and the mesh comes from a second run with
+  /// MeshOptions::covered_faces_along_lines (its seconds are in seconds_by_stage["first_run"]).
+  std::int64_t retried_along_lines = 0;
   std::map<std::string, double> seconds_by_stage;
   double seconds_total = 0;
 };
