@@ -620,6 +620,24 @@ void BspComplex::overlay_covered_face(Index f, const std::vector<Index>& over, i
   replace_face(f, std::move(pieces));
 }
 
+std::array<Index, 2> BspComplex::split_face_in_plane(Index f, Index q) {
+  VertexSigns& sign = signs_;
+  sign.reset();
+  for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
+  cut_crossing_edges(f, q, sign);
+  const auto [i0, i1] = split_face(f, q, sign);
+  for (int side = 0; side < 2; ++side) {
+    const Index c = faces_[i0].cell[side];
+    if (c < 0) continue;
+    auto& fl = cells_[c].faces;
+    auto it = std::find(fl.begin(), fl.end(), f);
+    if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
+    *it = i0;
+    fl.push_back(i1);
+  }
+  return {i0, i1};
+}
+
 void BspComplex::refine_covered_faces() {
   // The input triangle across each input edge, to tell the edges where the surface leaves a plane
   // (patch boundaries) from those between two triangles of the same plane.
@@ -662,21 +680,7 @@ void BspComplex::refine_covered_faces() {
         if (segment_crosses_face(f, a, b, axis, fo)) cut_a = a, cut_b = b;
       }
     if (cut_a >= 0) {
-      const Index q = edge_plane(cut_a, cut_b, faces_[f].plane);
-      VertexSigns& sign = signs_;
-      sign.reset();
-      for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
-      cut_crossing_edges(f, q, sign);
-      const auto [i0, i1] = split_face(f, q, sign);
-      for (int side = 0; side < 2; ++side) {
-        const Index c = faces_[i0].cell[side];
-        if (c < 0) continue;
-        auto& fl = cells_[c].faces;
-        auto it = std::find(fl.begin(), fl.end(), f);
-        if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
-        *it = i0;
-        fl.push_back(i1);
-      }
+      const auto [i0, i1] = split_face_in_plane(f, edge_plane(cut_a, cut_b, faces_[f].plane));
       work.push_back(i1);
       work.push_back(i0);
       if (debug_checks_) check_consistency();
@@ -731,21 +735,7 @@ void BspComplex::refine_covered_faces_along_lines() {
       faces_[f].coplanar = {cover};
       continue;
     }
-    const Index q = edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane);
-    VertexSigns& sign = signs_;
-    sign.reset();
-    for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
-    cut_crossing_edges(f, q, sign);
-    const auto [i0, i1] = split_face(f, q, sign);
-    for (int side = 0; side < 2; ++side) {
-      const Index c = faces_[i0].cell[side];
-      if (c < 0) continue;
-      auto& fl = cells_[c].faces;
-      auto it = std::find(fl.begin(), fl.end(), f);
-      if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
-      *it = i0;
-      fl.push_back(i1);
-    }
+    const auto [i0, i1] = split_face_in_plane(f, edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane));
     work.push_back(i1);
     work.push_back(i0);
     if (debug_checks_) check_consistency();

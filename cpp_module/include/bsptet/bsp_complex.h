@@ -159,6 +159,10 @@ class BspComplex {
   Index edge_plane(Index a, Index b, Index face_plane);
   /// Exact: does closed input segment (a, b), in f's plane, meet the interior of face f?
   bool segment_crosses_face(Index f, Index a, Index b, int axis, int face_orientation);
+  /// Splits face f (on an input plane) by plane q through a line of that plane, which crosses its
+  /// interior: the crossed edges are cut for every face using them, and both cells of f get the
+  /// two halves. Returns {positive half, negative half}.
+  std::array<Index, 2> split_face_in_plane(Index f, Index q);
   /// Replaces face f by `pieces` (same plane and cells) in both of its cells.
   void replace_face(Index f, std::vector<BspFace> pieces);
   /// f lies in the union of the coplanar input triangles `over` (each overlapping it): makes every
