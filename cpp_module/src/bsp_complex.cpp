@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <unordered_set>
 
 #include "bsptet/errors.h"
 
@@ -262,16 +263,7 @@ bool BspComplex::split_cell(Index c, Index p) {
     }
     if (fp && fn) {
       const auto [ip, in] = split_face(f, p, sign);
-      // The neighbour across f gets both halves.
-      for (int side = 0; side < 2; ++side) {
-        const Index other = faces_[ip].cell[side];
-        if (other < 0 || other == c) continue;
-        auto& fl = cells_[other].faces;
-        auto it = std::find(fl.begin(), fl.end(), f);
-        if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
-        *it = ip;
-        fl.push_back(in);
-      }
+      substitute_face(f, {ip, in}, c);  // the neighbour across f gets both halves
       pos_faces.push_back(ip);
       neg_faces.push_back(in);
     } else if (fp) {
@@ -478,14 +470,17 @@ bool BspComplex::segment_crosses_face(Index f, Index a, Index b, int axis, int f
 }
 
 void BspComplex::replace_face(Index f, std::vector<BspFace> pieces) {
-  const BspFace old = faces_[f];
   unregister_edges(f);
   faces_[f].alive = false;
   std::vector<Index> ids;
   for (auto& piece : pieces) ids.push_back(new_face(std::move(piece)));
+  substitute_face(f, ids);
+}
+
+void BspComplex::substitute_face(Index f, const std::vector<Index>& ids, Index skip_cell) {
   for (int side = 0; side < 2; ++side) {
-    const Index c = old.cell[side];
-    if (c < 0) continue;
+    const Index c = faces_[ids[0]].cell[side];
+    if (c < 0 || c == skip_cell) continue;
     auto& fl = cells_[c].faces;
     auto it = std::find(fl.begin(), fl.end(), f);
     if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
@@ -504,10 +499,14 @@ void BspComplex::overlay_covered_face(Index f, const std::vector<Index>& over, i
   };
   // 1. Every point where an edge of a covering triangle meets an edge of f becomes a vertex of f
   // (for every face using that edge: conformity). Input vertices on f's edges are used as they are.
+  // Each input edge once, as its first covering triangle has it: two covering triangles share most
+  // edges, and the second visit could only find the crossings already made.
+  std::unordered_set<std::uint64_t> seen;
   for (Index t : over) {
     const std::array<Index, 3> tv = ccw(t);
     for (int k = 0; k < 3; ++k) {
       const Index a = tv[k], b = tv[(k + 1) % 3];
+      if (!seen.insert(edge_key(a, b)).second) continue;
       for (std::size_t i = 0; i < faces_[f].verts.size(); ++i) {
         const auto& v = faces_[f].verts;
         const Index u = v[i], w = v[(i + 1) % v.size()];
@@ -626,16 +625,15 @@ std::array<Index, 2> BspComplex::split_face_in_plane(Index f, Index q) {
   for (Index v : faces_[f].verts) sign[v] = to_int(geo_.side(q, v));
   cut_crossing_edges(f, q, sign);
   const auto [i0, i1] = split_face(f, q, sign);
-  for (int side = 0; side < 2; ++side) {
-    const Index c = faces_[i0].cell[side];
-    if (c < 0) continue;
-    auto& fl = cells_[c].faces;
-    auto it = std::find(fl.begin(), fl.end(), f);
-    if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
-    *it = i0;
-    fl.push_back(i1);
-  }
+  substitute_face(f, {i0, i1});
   return {i0, i1};
+}
+
+std::vector<Index> BspComplex::faces_on_input_planes() const {
+  std::vector<Index> work;
+  for (std::size_t f = faces_.size(); f-- > 0;)
+    if (faces_[f].alive && !faces_[f].coplanar.empty()) work.push_back(static_cast<Index>(f));
+  return work;
 }
 
 void BspComplex::refine_covered_faces() {
@@ -653,10 +651,7 @@ void BspComplex::refine_covered_faces() {
     const Index other = e[0] == t ? e[1] : e[0];
     return other < 0 || tri_plane_[other] != tri_plane_[t];
   };
-  std::vector<Index> work;
-  for (std::size_t f = 0; f < faces_.size(); ++f)
-    if (faces_[f].alive && !faces_[f].coplanar.empty()) work.push_back(static_cast<Index>(f));
-  std::reverse(work.begin(), work.end());
+  std::vector<Index> work = faces_on_input_planes();
   while (!work.empty()) {
     const Index f = work.back();
     work.pop_back();
@@ -698,10 +693,7 @@ void BspComplex::refine_covered_faces() {
 }
 
 void BspComplex::refine_covered_faces_along_lines() {
-  std::vector<Index> work;
-  for (std::size_t f = 0; f < faces_.size(); ++f)
-    if (faces_[f].alive && !faces_[f].coplanar.empty()) work.push_back(static_cast<Index>(f));
-  std::reverse(work.begin(), work.end());
+  std::vector<Index> work = faces_on_input_planes();
   while (!work.empty()) {
     const Index f = work.back();
     work.pop_back();

@@ -526,28 +526,20 @@ bool ImplicitGeometry::known_collinear(Index x, Index y, Index z) const {
   // x, y, z are collinear when x is a TPI vertex and y, z lie on two of its three defining planes
   // (independent planes: they meet in a line). This is a vertex a split left on an edge, with
   // points of that edge.
-  auto on = [&](Index v, Index q) {
-    const auto& l = verts_[v].on_planes;
-    return std::find(l.begin(), l.end(), q) != l.end();
-  };
   auto through = [&](Index t, Index u, Index w) {
     const Vertex& vt = verts_[t];
     if (vt.explicit_id >= 0 || vt.centroid_of[0] >= 0) return false;
     int common = 0;
     for (Index q : vt.planes)
-      if (on(u, q) && on(w, q)) ++common;
+      if (known_on_plane(u, q) && known_on_plane(w, q)) ++common;
     return common >= 2;
   };
   return through(x, y, z) || through(y, z, x) || through(z, x, y);
 }
 
 bool ImplicitGeometry::known_coplanar(Index a, Index b, Index c, Index d) const {
-  auto on = [&](Index v, Index q) {
-    const auto& l = verts_[v].on_planes;
-    return std::find(l.begin(), l.end(), q) != l.end();
-  };
   for (Index q : verts_[a].on_planes)
-    if (on(b, q) && on(c, q) && on(d, q)) return true;
+    if (known_on_plane(b, q) && known_on_plane(c, q) && known_on_plane(d, q)) return true;
   // Three of them on one line are coplanar with any fourth.
   return known_collinear(b, c, d) || known_collinear(a, c, d) || known_collinear(a, b, d) || known_collinear(a, b, c);
 }

@@ -44,9 +44,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--along-lines")) o.covered_faces_along_lines = true;
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--progress"))
-      o.progress = [](const std::string& stage, double f) {
-        static std::string last;
-        static int last_pct = -1;
+      o.progress = [last = std::string(), last_pct = -1](const std::string& stage, double f) mutable {
         const int pct = static_cast<int>(f * 100);
         if (stage != last || pct != last_pct) std::fprintf(stderr, "[%s %d%%]\n", stage.c_str(), pct);
         last = stage;

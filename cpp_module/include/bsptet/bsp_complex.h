@@ -163,6 +163,10 @@ class BspComplex {
   /// interior: the crossed edges are cut for every face using them, and both cells of f get the
   /// two halves. Returns {positive half, negative half}.
   std::array<Index, 2> split_face_in_plane(Index f, Index q);
+  /// Live faces that may overlap input triangles of their plane, as a work stack (lowest id on top).
+  std::vector<Index> faces_on_input_planes() const;
+  /// In the face lists of f's cells (but `skip_cell`), f becomes ids[0] and ids[1..] are appended.
+  void substitute_face(Index f, const std::vector<Index>& ids, Index skip_cell = -1);
   /// Replaces face f by `pieces` (same plane and cells) in both of its cells.
   void replace_face(Index f, std::vector<BspFace> pieces);
   /// f lies in the union of the coplanar input triangles `over` (each overlapping it): makes every
