@@ -266,10 +266,10 @@ def _merge_stats(all_stats):
                     if isinstance(value, (int, float)) and not isinstance(value, bool):
                         agg[key] = agg.get(key, 0) + value
                 continue
-            if k == "seconds_by_stage":
+            if k in ("seconds_by_stage", "steiner_seconds_by_phase", "steiner_removed_by_phase"):
                 agg = out.setdefault(k, {})
-                for stage, sec in v.items():
-                    agg[stage] = agg.get(stage, 0.0) + sec
+                for stage, value in v.items():
+                    agg[stage] = agg.get(stage, 0) + value
             else:
                 out[k] = out.get(k, 0) + v
     qs = [st["quality"] for st in all_stats]

@@ -3,7 +3,8 @@
 time limit: either a mesh (nodes, tets, seconds, boundary nodes put on the CAD) or the message the
 user would see. Usage:
 
-    bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--timeout S] [--markdown F]
+    bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--size-of-diagonal F]
+                                [--timeout S] [--markdown F]
 
 Default folder: tests/data/cad. Prints one row per file.
 """
@@ -30,6 +31,9 @@ def main():
     ap.add_argument("--order", type=int, choices=(1, 2), default=1)
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--markdown", default=None)
+    ap.add_argument("--size-of-diagonal", type=float, default=0.0, metavar="F",
+                    help="CharacteristicLengthMax = F * the shape's bounding-box diagonal "
+                         "(default 0: automatic, the mesher object's default)")
     args = ap.parse_args()
     import_freecad()
     import Part
@@ -44,7 +48,8 @@ def main():
             rows.append((name, "-", "-", "unreadable: %s" % e, "", "", ""))
             print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
-        job = MeshJob(shape, MeshParameters(order=args.order, compare_tetgen=False),
+        size = args.size_of_diagonal * shape.BoundBox.DiagonalLength
+        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False),
                       source=name, python="/usr/bin/python3")
         job.start()
         if not job.wait(args.timeout):

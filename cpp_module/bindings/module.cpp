@@ -181,6 +181,8 @@ PYBIND11_MODULE(_bsptet, m) {
         d["apex_cells"] = st.apex_cells;
         d["pulled_cells"] = st.pulled_cells;
         d["seconds_by_stage"] = st.seconds_by_stage;
+        d["steiner_seconds_by_phase"] = st.steiner_seconds_by_phase;
+        d["steiner_removed_by_phase"] = st.steiner_removed_by_phase;
         d["seconds_core"] = st.seconds_total;
         return py::make_tuple(points_array(mesh), tets_array(mesh), d);
       },

@@ -238,6 +238,8 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   st.boundary_steiner_before_removal = ss.boundary_steiner_before;
   st.collapsed = ss.collapsed;
   st.relocated = ss.relocated;
+  st.steiner_seconds_by_phase = ss.seconds_by_phase;
+  st.steiner_removed_by_phase = ss.removed_by_phase;
   st.pushed = ss.pushed;
   st.apex_cells = cell_tets.apex_cells;
   st.pulled_cells = cell_tets.pulled_cells;

@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg,
                 st.retried_along_lines ? " (retried along lines)" : "");
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);
+    std::printf("\n  steiner removal:");
+    for (const auto& [phase, sec] : st.steiner_seconds_by_phase)
+      std::printf("  %s %.3f s -%lld", phase.c_str(), sec,
+                  static_cast<long long>(st.steiner_removed_by_phase.at(phase)));
     std::printf("\n");
     for (const auto& msg : r.messages) std::printf("  %s\n", msg.c_str());
     if (!stem.empty()) write_tetgen(stem, m);

@@ -55,6 +55,9 @@ struct MeshStats {
   /// MeshOptions::covered_faces_along_lines (its seconds are in seconds_by_stage["first_run"]).
   std::int64_t retried_along_lines = 0;
   std::map<std::string, double> seconds_by_stage;
+  /// The Steiner removal's phases (SteinerRemovalStats::seconds_by_phase, removed_by_phase).
+  std::map<std::string, double> steiner_seconds_by_phase;
+  std::map<std::string, std::int64_t> steiner_removed_by_phase;
   double seconds_total = 0;
 };
 

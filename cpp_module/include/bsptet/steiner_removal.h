@@ -95,6 +95,8 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "bsptet/cell_tetrahedralize.h"
@@ -113,6 +115,11 @@ struct SteinerRemovalStats {
   std::int64_t steiner_before = 0, boundary_steiner_before = 0;
   std::int64_t collapsed = 0, relocated = 0, rounded = 0, rounded_moved = 0, pushed = 0;
   std::int64_t boundary_steiner_after = 0;
+  /// Per phase of the order above ("collapse", "relocate", "merge", "cone_neighbours",
+  /// "edge_removal", "cone_nearest", "retetrahedralize", "round"): seconds spent, and how many
+  /// Steiner points were gone at its end (collapse passes run inside other phases count there).
+  std::map<std::string, double> seconds_by_phase;
+  std::map<std::string, std::int64_t> removed_by_phase;
 };
 
 /// Removes and relocates Steiner points as described above. `tri_plane[t]` is the plane of input
