@@ -1,11 +1,11 @@
-"""Property tests of the mesher: transformed, scaled and perturbed paper models, random star-shaped
-polyhedra and twisted prisms. Each output is checked exactly against its input surface (valid, no
+"""Property tests of the mesher: transformed, scaled and perturbed paper models and corpus models
+(real CAD tessellations), random star-shaped polyhedra and twisted prisms. Each output is checked exactly against its input surface (valid, no
 Steiner point on the surface). Seeds are fixed and printed, so a failure can be replayed."""
 
 import numpy as np
 import pytest
 from analytic_surfaces import lat_long_sphere
-from conftest import PAPER_MODELS, paper_path
+from conftest import PAPER_MODELS, corpus_path, paper_path
 
 from FemBspTet import core
 from FemBspTet.mesh_types import Surface
@@ -51,6 +51,30 @@ def test_near_degenerate_perturbations(model, seed):
     pts = s.points.copy()
     pick = rng.random(len(pts)) < 1 / 3
     pts[pick] += rng.normal(size=(pick.sum(), 3)) * size * rng.choice([1e-15, 1e-13, 1e-12])
+    print(f"seed {seed} model {model}")
+    _mesh_and_check(Surface(pts, s.triangles), f"{model} perturbed seed {seed}")
+
+
+@pytest.mark.parametrize("model,seed,scale", [("hinge", 51, 1e-3), ("pinion", 52, 1e3),
+                                              ("anchor", 53, 1.0)])
+def test_rotated_translated_scaled_corpus_models(model, seed, scale):
+    # A rotation makes every plane of a CAD tessellation generic (none axis-aligned any more).
+    rng = np.random.default_rng(seed)
+    s = read_surface(corpus_path(model))
+    pts = (s.points @ _random_rotation(rng).T) * scale + rng.normal(size=3) * scale * 100
+    print(f"seed {seed} scale {scale:g} model {model}")
+    _mesh_and_check(Surface(pts, s.triangles), f"{model} seed {seed} scale {scale:g}")
+
+
+@pytest.mark.parametrize("model,seed", [("hinge", 61), ("pinion", 62)])
+def test_near_degenerate_perturbations_of_corpus_models(model, seed):
+    # Coplanar patches of a CAD tessellation become nearly coplanar (1e-13 of the size).
+    rng = np.random.default_rng(seed)
+    s = read_surface(corpus_path(model))
+    size = np.ptp(s.points, axis=0).max()
+    pts = s.points.copy()
+    pick = rng.random(len(pts)) < 1 / 3
+    pts[pick] += rng.normal(size=(pick.sum(), 3)) * size * 1e-13
     print(f"seed {seed} model {model}")
     _mesh_and_check(Surface(pts, s.triangles), f"{model} perturbed seed {seed}")
 
