@@ -74,7 +74,116 @@ bool orient3d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, cons
   return true;
 }
 
+// ---- Floating-point expansions (Priest; Shewchuk 1997) -------------------------------------
+// An expansion is a sum of doubles, stored by increasing magnitude, no two overlapping; its sign
+// is the sign of its last (largest) component. TwoSum is exact for any finite operands (with
+// subnormals); TwoProduct (fma residual) is exact when the product's residual does not underflow,
+// which orient3d_expansion guarantees by its range check. Zero components are dropped, so an
+// expansion equal to zero is the single component 0.
+inline void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double bv = x - a, av = x - bv;
+  y = (a - av) + (b - bv);
+}
+inline void two_product(double a, double b, double& x, double& y) {
+  x = a * b;
+  y = std::fma(a, b, -x);
+}
+// h = e + b (h may not alias e). Returns h's length.
+int grow_expansion(const double* e, int n, double b, double* h) {
+  double q = b;
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    double hh;
+    two_sum(q, e[i], q, hh);
+    if (hh != 0) h[k++] = hh;
+  }
+  if (q != 0 || k == 0) h[k++] = q;
+  return k;
+}
+// h = e + f, by growing e with each component of f (small expansions only). h must hold n + m
+// components and may not alias e or f; `tmp` is scratch of the same size.
+int expansion_sum(const double* e, int n, const double* f, int m, double* h, double* tmp) {
+  int len = n;
+  for (int i = 0; i < n; ++i) h[i] = e[i];
+  for (int j = 0; j < m; ++j) {
+    len = grow_expansion(h, len, f[j], tmp);
+    for (int i = 0; i < len; ++i) h[i] = tmp[i];
+  }
+  return len;
+}
+// h = e * b. h must hold 2n components and may not alias e.
+int scale_expansion(const double* e, int n, double b, double* h) {
+  double q, hh;
+  int k = 0;
+  two_product(e[0], b, q, hh);
+  if (hh != 0) h[k++] = hh;
+  for (int i = 1; i < n; ++i) {
+    double p1, p0, sum;
+    two_product(e[i], b, p1, p0);
+    two_sum(q, p0, sum, hh);
+    if (hh != 0) h[k++] = hh;
+    two_sum(p1, sum, q, hh);
+    if (hh != 0) h[k++] = hh;
+  }
+  if (q != 0 || k == 0) h[k++] = q;
+  return k;
+}
+// The 2x2 minor p.x * q.y - q.x * p.y as an expansion of at most 4 components.
+int minor_xy(const Vec3& p, const Vec3& q, double* h) {
+  double a[2], b[2], tmp[4];
+  two_product(p.x, q.y, a[1], a[0]);
+  two_product(q.x, p.y, b[1], b[0]);
+  b[0] = -b[0], b[1] = -b[1];
+  return expansion_sum(a, 2, b, 2, h, tmp);
+}
+
 }  // namespace
+
+// sign(orient3d) by expansions, or false when a coordinate is outside [2^-200, 2^200] in
+// magnitude (then a TwoProduct residual could underflow or a sum overflow: use ExactFloat).
+// det[b - a, c - a, d - a] = -det4 with det4 the 4x4 determinant of rows (x, y, z, 1) of a, b, c,
+// d; by Laplace expansion on the (x, y) columns, det4 = za A + zb B + zc C + zd D with the 2x2
+// minors m_pq = xp yq - xq yp: A = m_bc - m_bd + m_cd, B = m_ad - m_ac - m_cd,
+// C = m_ab - m_ad + m_bd, D = m_ac - m_ab - m_bc.
+bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
+  for (const Vec3* p : {&a, &b, &c, &d})
+    for (int k = 0; k < 3; ++k) {
+      const double m = std::fabs((*p)[k]);
+      if (m != 0 && !(m >= 0x1p-200 && m <= 0x1p200)) return false;
+    }
+  struct Minor {
+    double e[4];
+    int n;
+  };
+  Minor mab, mac, mad, mbc, mbd, mcd;
+  mab.n = minor_xy(a, b, mab.e), mac.n = minor_xy(a, c, mac.e), mad.n = minor_xy(a, d, mad.e);
+  mbc.n = minor_xy(b, c, mbc.e), mbd.n = minor_xy(b, d, mbd.e), mcd.n = minor_xy(c, d, mcd.e);
+  double total[96], scratch[96];
+  int total_len = 1;
+  total[0] = 0;
+  // total += z * (s1 m1 + s2 m2 + s3 m3), signs s = +1 or -1. Lengths: coefficient <= 12,
+  // scaled <= 24, total <= 4 * 24.
+  auto add_term = [&](const Minor& m1, double s1, const Minor& m2, double s2, const Minor& m3, double s3,
+                      double z) {
+    double t1[4], t2[4], t3[4], c12[8], coef[12], tmp[12], scaled[24], sum[96];
+    for (int i = 0; i < m1.n; ++i) t1[i] = s1 * m1.e[i];
+    for (int i = 0; i < m2.n; ++i) t2[i] = s2 * m2.e[i];
+    for (int i = 0; i < m3.n; ++i) t3[i] = s3 * m3.e[i];
+    const int n12 = expansion_sum(t1, m1.n, t2, m2.n, c12, tmp);
+    const int nc = expansion_sum(c12, n12, t3, m3.n, coef, tmp);
+    const int ns = scale_expansion(coef, nc, z, scaled);
+    const int nt = expansion_sum(total, total_len, scaled, ns, sum, scratch);
+    for (int i = 0; i < nt; ++i) total[i] = sum[i];
+    total_len = nt;
+  };
+  add_term(mbc, 1, mbd, -1, mcd, 1, a.z);   // A = m_bc - m_bd + m_cd
+  add_term(mad, 1, mac, -1, mcd, -1, b.z);  // B = m_ad - m_ac - m_cd
+  add_term(mab, 1, mad, -1, mbd, 1, c.z);   // C = m_ab - m_ad + m_bd
+  add_term(mac, 1, mab, -1, mbc, -1, d.z);  // D = m_ac - m_ab - m_bc
+  out = sign_of(-total[total_len - 1]);
+  return true;
+}
 
 Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   // det[b - a, c - a, d - a]
@@ -99,6 +208,7 @@ Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > bound) return sign_of(det);
   Sign certified;
   if (orient3d_exact_in_doubles(a, b, c, d, certified)) return certified;
+  if (orient3d_expansion(a, b, c, d, certified)) return certified;
   return orient3d_exact(a, b, c, d);
 }
 

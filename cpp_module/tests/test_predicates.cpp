@@ -83,6 +83,56 @@ TEST(Orient3d, FilterAgreesWithExact) {
   EXPECT_GT(degenerate, 1000) << "the test must exercise exact zeros";
 }
 
+// The expansion path alone against ExactFloat, on the inputs the filter cannot decide: points
+// rounded onto generic planes (orient3d tiny but mostly not zero), exactly coplanar grid points
+// far from the origin, and points one ulp off such planes.
+TEST(Orient3d, ExpansionsAgreeWithExactFloat) {
+  const unsigned seed = 20261123u;
+  std::printf("seed %u\n", seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::uniform_int_distribution<int> scale_exp(-150, 150);
+  int zeros = 0, nonzeros = 0, refused = 0;
+  for (int it = 0; it < 100000; ++it) {
+    const double s = std::ldexp(1.0, scale_exp(rng));
+    const double shift = (it % 5 == 0) ? 1e7 * s : 0.0;
+    Vec3 p[4];
+    if (it % 3 == 0) {
+      // Four points rounded onto the plane through three random ones.
+      Vec3 q[3];
+      for (auto& v : q) v = {U(rng) * s + shift, U(rng) * s, U(rng) * s - shift};
+      for (int k = 0; k < 4; ++k) {
+        const double u = U(rng), w = U(rng);
+        p[k] = {q[0].x + u * (q[1].x - q[0].x) + w * (q[2].x - q[0].x),
+                q[0].y + u * (q[1].y - q[0].y) + w * (q[2].y - q[0].y),
+                q[0].z + u * (q[1].z - q[0].z) + w * (q[2].z - q[0].z)};
+      }
+    } else {
+      // Integer points on the plane z = i x + j y + k (exactly coplanar), scaled by s.
+      const double i = std::round(U(rng) * 3), j = std::round(U(rng) * 3), k = std::round(U(rng) * 50);
+      for (auto& v : p) {
+        const double x = std::round(U(rng) * 1000), y = std::round(U(rng) * 1000);
+        v = {x * s + shift, y * s, (i * x + j * y + k) * s};
+      }
+      if (it % 3 == 2) p[3].y = std::nextafter(p[3].y, (it & 8) ? INFINITY : -INFINITY);
+    }
+    Sign got;
+    if (!orient3d_expansion(p[0], p[1], p[2], p[3], got)) {
+      ++refused;
+      continue;
+    }
+    const Sign want = orient3d_exact(p[0], p[1], p[2], p[3]);
+    ASSERT_EQ(got, want) << "iteration " << it << " seed " << seed;
+    (want == Sign::kZero ? zeros : nonzeros) += 1;
+  }
+  EXPECT_GT(zeros, 10000);
+  EXPECT_GT(nonzeros, 10000);
+  EXPECT_LT(refused, 100);  // a subnormal coordinate (the ulp step off 0), refused by design
+  Sign out;
+  EXPECT_FALSE(orient3d_expansion({1e-70, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
+  EXPECT_FALSE(orient3d_expansion({1e70, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
+}
+
 TEST(Orient3d, ExtremeMagnitudes) {
   for (double s : {1e-300, 1e-150, 1e-6, 1.0, 1e6, 1e150, 1e300}) {
     const Vec3 a{0, 0, 0}, b{s, 0, 0}, c{0, s, 0}, d{0, 0, s}, e{s / 4, s / 4, 0};

@@ -1,6 +1,7 @@
 // FemBspTet core: the geometric predicates on double coordinates. The only sign authority for
 // double inputs: a floating-point filter with a proven error bound decides when it can; otherwise
-// the sign is computed exactly (ExactFloat). Results are exact for every finite input.
+// the sign is computed exactly (orient3d: floating-point expansions, ExactFloat outside their safe
+// range; orient2d: ExactFloat). Results are exact for every finite input.
 //
 // Sign conventions (stated once):
 //  * orient3d(a, b, c, d) = sign(det[b - a, c - a, d - a]). POSITIVE when d lies on the side into
@@ -28,5 +29,9 @@ Sign orient2d_projected(const Vec3& a, const Vec3& b, const Vec3& c, int axis);
 /// Exact-only versions (no filter), for differential tests of the filters.
 Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int axis);
+/// The exact sign of orient3d by floating-point expansions (no GMP; what orient3d uses when its
+/// filter fails); false, and `out` unset, when a nonzero coordinate's magnitude is outside
+/// [2^-200, 2^200] (orient3d then uses orient3d_exact).
+bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
 
 }  // namespace bsptet
