@@ -831,16 +831,17 @@ class TetComplex {
   /// inside the grown cavity vanish with v. Returns false, changing nothing, otherwise.
   bool cone_from_vertex(Index v, Index u, int max_grow, std::size_t max_tets) {
     if (!vb_[v].empty() || v < np_) return false;
-    std::vector<Index> cav = vt_[v];
-    std::sort(cav.begin(), cav.end());
-    std::vector<std::array<Index, 4>> repl;
-    // v's star boundary, kept for the next call while v's star is unchanged (callers try one v
-    // with many u in a row).
+    // v's star (sorted) and its boundary, kept for the next call while v's star is unchanged
+    // (callers try one v with many u in a row).
     if (star_boundary_of_ != v || star_boundary_version_ != version_[v]) {
-      star_boundary_ = boundary_pairs(cav);
+      star_sorted_ = vt_[v];
+      std::sort(star_sorted_.begin(), star_sorted_.end());
+      star_boundary_ = boundary_pairs(star_sorted_);
       star_boundary_of_ = v;
       star_boundary_version_ = version_[v];
     }
+    std::vector<Index> cav = star_sorted_;
+    std::vector<std::array<Index, 4>> repl;
     std::vector<FacePair> boundary = star_boundary_;
     SeesFace sees(geo_, u, max_grow > 0);
     for (int grow = 0; grow <= max_grow; ++grow) {
@@ -1074,6 +1075,7 @@ class TetComplex {
   std::vector<char> falive_;
   std::vector<std::vector<Index>> vb_;
   std::vector<std::uint64_t> version_;  ///< changes at each vertex (signature())
+  std::vector<Index> star_sorted_;       ///< cone_from_vertex: star_boundary_of_'s star, sorted
   std::vector<FacePair> star_boundary_;  ///< cone_from_vertex: boundary of star_boundary_of_'s star
   Index star_boundary_of_ = -1;
   std::uint64_t star_boundary_version_ = 0;
