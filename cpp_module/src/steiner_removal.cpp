@@ -1120,7 +1120,13 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
   }
   // Collapse attempts that failed, with the signature they failed under: skipped until it changes
   // (they would fail again; the collapses made are the same, only the repeated failures go).
-  std::unordered_map<Index, std::pair<std::uint64_t, std::uint64_t>> failed_collapse;
+  // The neighbours are kept too: while v's own counter is unchanged so is its star, hence its
+  // neighbours, and the signature is re-checked without recomputing them.
+  struct FailedCollapse {
+    std::pair<std::uint64_t, std::uint64_t> signature;
+    std::vector<Index> neighbours;
+  };
+  std::unordered_map<Index, FailedCollapse> failed_collapse;
   auto collapse_passes = [&](double f0, double f1) {
     for (int pass = 0; pass < 50; ++pass) {
       bool changed = false;
@@ -1132,10 +1138,12 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
           progress(f0 + (f1 - f0) * (pass + static_cast<double>(i) / sv.size()) / (pass + 2));
         }
         if (!mesh.used(v)) continue;
+        const auto known = failed_collapse.find(v);
+        if (known != failed_collapse.end() &&
+            mesh.signature(v, known->second.neighbours) == known->second.signature)
+          continue;
         const std::vector<Index> nbrs = mesh.neighbours(v);
         const auto sig = mesh.signature(v, nbrs);
-        const auto known = failed_collapse.find(v);
-        if (known != failed_collapse.end() && known->second == sig) continue;
         const std::vector<Index> lv = mesh.labels(v);
         bool done = false;
         for (Index u : nbrs) {
@@ -1146,7 +1154,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
             break;
           }
         }
-        if (!done) failed_collapse[v] = sig;
+        if (!done) failed_collapse[v] = FailedCollapse{sig, nbrs};
       }
       if (!changed) break;
     }
