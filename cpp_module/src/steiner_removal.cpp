@@ -1171,8 +1171,11 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       std::int64_t moved = 0;
       Index stuck = -1;
       std::string why;
-      for (Index v : steiner_vertices()) {
+      const std::vector<Index> sv = steiner_vertices();
+      for (std::size_t i = 0; i < sv.size(); ++i) {
+        const Index v = sv[i];
         check_cancel();
+        if ((i & 63) == 0) progress(0.5 + 0.1 * static_cast<double>(i) / sv.size());
         const std::vector<Index> lv = mesh.labels(v);
         if (lv.empty()) continue;
         if (options.allow_boundary_steiner) {
