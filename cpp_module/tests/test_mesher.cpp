@@ -48,6 +48,15 @@ TEST_P(PaperPolyhedron, DefaultMeshIsValidWithNoSurfaceSteinerPoint) {
   EXPECT_LE(st.steiner_points, c.tetgen_steiner);
   EXPECT_EQ(r.steiner_points, st.steiner_points);
   EXPECT_EQ(r.tets, st.tets);
+  // The Steiner removal's phases account for every point it removed (rounding removes none).
+  EXPECT_EQ(st.steiner_seconds_by_phase.size(), 8u);
+  std::int64_t removed = 0;
+  for (const auto& [phase, n] : st.steiner_removed_by_phase) {
+    EXPECT_GE(n, 0) << phase;
+    EXPECT_GE(st.steiner_seconds_by_phase.at(phase), 0.0) << phase;
+    removed += n;
+  }
+  EXPECT_EQ(removed, st.steiner_before_removal - st.steiner_points);
   // Deterministic: the same input gives the same mesh.
   const TetMesh again = tetrahedralize(s, o);
   EXPECT_EQ(again.xyz, m.xyz);
