@@ -40,19 +40,25 @@ def test_rotated_translated_scaled_paper_models(model, seed, scale):
     _mesh_and_check(Surface(pts, s.triangles), f"{model} seed {seed} scale {scale:g}")
 
 
+def _perturbed(path, seed, relative_sizes):
+    """The surface at `path` with a third of its points moved by a random multiple of the model
+    size times one of `relative_sizes` (a few ulps to 1e-12): coplanar faces become nearly
+    coplanar, the hardest case for rounding."""
+    rng = np.random.default_rng(seed)
+    s = read_surface(path)
+    size = np.ptp(s.points, axis=0).max()
+    pts = s.points.copy()
+    pick = rng.random(len(pts)) < 1 / 3
+    pts[pick] += rng.normal(size=(pick.sum(), 3)) * size * rng.choice(relative_sizes)
+    print(f"seed {seed} model {path}")
+    return Surface(pts, s.triangles)
+
+
 @pytest.mark.parametrize("model", PAPER_MODELS)
 @pytest.mark.parametrize("seed", [21, 22])
 def test_near_degenerate_perturbations(model, seed):
-    rng = np.random.default_rng(seed)
-    s = read_surface(paper_path(model))
-    size = np.ptp(s.points, axis=0).max()
-    # Perturb a third of the points by a few ulps to 1e-12 of the size: coplanar faces become
-    # nearly coplanar, the hardest case for rounding.
-    pts = s.points.copy()
-    pick = rng.random(len(pts)) < 1 / 3
-    pts[pick] += rng.normal(size=(pick.sum(), 3)) * size * rng.choice([1e-15, 1e-13, 1e-12])
-    print(f"seed {seed} model {model}")
-    _mesh_and_check(Surface(pts, s.triangles), f"{model} perturbed seed {seed}")
+    s = _perturbed(paper_path(model), seed, [1e-15, 1e-13, 1e-12])
+    _mesh_and_check(s, f"{model} perturbed seed {seed}")
 
 
 @pytest.mark.parametrize("model,seed,scale", [("hinge", 51, 1e-3), ("pinion", 52, 1e3),
@@ -69,14 +75,8 @@ def test_rotated_translated_scaled_corpus_models(model, seed, scale):
 @pytest.mark.parametrize("model,seed", [("hinge", 61), ("pinion", 62)])
 def test_near_degenerate_perturbations_of_corpus_models(model, seed):
     # Coplanar patches of a CAD tessellation become nearly coplanar (1e-13 of the size).
-    rng = np.random.default_rng(seed)
-    s = read_surface(corpus_path(model))
-    size = np.ptp(s.points, axis=0).max()
-    pts = s.points.copy()
-    pick = rng.random(len(pts)) < 1 / 3
-    pts[pick] += rng.normal(size=(pick.sum(), 3)) * size * 1e-13
-    print(f"seed {seed} model {model}")
-    _mesh_and_check(Surface(pts, s.triangles), f"{model} perturbed seed {seed}")
+    s = _perturbed(corpus_path(model), seed, [1e-13])
+    _mesh_and_check(s, f"{model} perturbed seed {seed}")
 
 
 def star_shaped(rng, n_lat, n_lon):
