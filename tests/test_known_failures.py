@@ -7,9 +7,13 @@ invalid mesh.
   0.4697 mm (what the FreeCAD mesher uses at CharacteristicLengthMax = diag / 20). 2,890
   triangles, closed, not self-intersecting. The Steiner removal cannot move the surface Steiner
   point at (-32.92279, -7.472853, 0.647637) (input triangle 1658, a needle 11.3 x 0.56 mm) inside.
-  As far as diagnosed: its star has link faces whose three corners lie (nearly) on one line,
-  x = -32.92279, z = 0.647637, through input points 1254 and 1314 and several Steiner points,
-  so no candidate sees them all, and growing the cavity reaches the surface; the retry along whole lines and the cone filler fail the same way (session
+  As far as diagnosed: the point (a TPI of planes 1498, 2310, 2312) has in its link input points
+  1254 and 1314, which differ by 7e-15 in x and 2e-15 in z (nearly on one line), three Steiner
+  points on that line (TPIs of planes 2210 and 2311), and a BSP point (TPI 11735) 1.4e-14 from
+  input point 1314: a plane that passes within rounding of an input vertex without going through
+  it leaves a fan of slivers that no candidate point sees strictly, and growing the cavity reaches
+  the surface. The fix probably belongs in the BSP (such nearly coincident planes and points), not
+  in the relocation; the retry along whole lines and the cone filler fail the same way (session
   7, docs/core-design.md). At the default deflection (diag / 500) the part meshes.
 """
 
