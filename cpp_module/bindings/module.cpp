@@ -175,6 +175,8 @@ PYBIND11_MODULE(_bsptet, m) {
         d["relocated"] = st.relocated;
         d["exact_fallbacks"] = st.exact_fallbacks;
         d["retried_along_lines"] = st.retried_along_lines;
+        d["retries"] = st.retries;
+        d["bsp_candidate_shift"] = st.bsp_candidate_shift;
         d["delaunay_cells"] = st.delaunay_cells;
         d["delaunay_recovered_cells"] = st.delaunay_recovered_cells;
         d["delaunay_fallback_cells"] = st.delaunay_fallback_cells;

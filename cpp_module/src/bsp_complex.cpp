@@ -117,7 +117,7 @@ Index BspComplex::choose_plane(Index c) {
   Index best = -1;
   long best_splits = 0, best_coplanar = 0;
   for (std::size_t i = 0; i < ncand; ++i) {
-    const Index p = tri_plane_[list[i * n / ncand]];
+    const Index p = tri_plane_[list[(i * n / ncand + candidate_shift_) % n]];
     long splits = 0, coplanar = 0;
     for (std::size_t j = 0; j < nsample; ++j) {
       const Index t = list[j * n / nsample];

@@ -192,6 +192,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
 
   t0 = Clock::now();
   BspComplex bsp(geo, surface, std::move(tri_plane));
+  bsp.set_candidate_shift(options.bsp_candidate_shift);
   bsp.set_debug_checks(options.debug_checks);
   if (options.debug_checks) bsp.check_consistency();
   bsp.build(options.cancelled, [&](double f) { progress("BSP tree", f); });
@@ -258,24 +259,41 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
 
 TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
   const auto t_start = Clock::now();
-  try {
-    return tetrahedralize_once(input, options, stats);
-  } catch (const MeshingError& e) {
-    // The Steiner removal can get stuck on a surface point it cannot move inside; the other
-    // refinement of the covered faces gives another complex (other points) and usually goes
-    // through. Anything else (bad input, cancelled, other stages) is reported as it is.
-    if (options.covered_faces_along_lines || e.code() != ErrorCode::kInternal || e.stage() != "steiner") throw;
-    MeshOptions again = options;
-    again.covered_faces_along_lines = true;
-    if (options.progress) options.progress("retrying: " + std::string(e.what()), 0);
-    MeshStats st;
-    TetMesh mesh = tetrahedralize_once(input, again, &st);
-    st.retried_along_lines = 1;
-    const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
-    st.seconds_by_stage["first_run"] = total - st.seconds_total;
-    st.seconds_total = total;
-    if (stats) *stats = st;
-    return mesh;
+  // The Steiner removal can get stuck on a surface point it cannot move inside (a fan of slivers
+  // from planes that pass within rounding of each other, docs/core-design.md). Another complex has
+  // other points and usually goes through: first the other refinement of the covered faces, then
+  // other partitions (BspComplex::set_candidate_shift 1, 2), each as valid as the first. Anything
+  // else (bad input, cancelled, other stages) is reported as it is, and so is the last attempt's
+  // failure.
+  std::vector<MeshOptions> attempts{options};
+  if (!options.covered_faces_along_lines) {
+    MeshOptions lines = options;
+    lines.covered_faces_along_lines = true;
+    attempts.push_back(lines);
+  }
+  for (std::size_t shift : {1, 2}) {
+    MeshOptions other = options;
+    other.bsp_candidate_shift = options.bsp_candidate_shift + shift;
+    attempts.push_back(other);
+  }
+  for (std::size_t k = 0;; ++k) {
+    try {
+      MeshStats st;
+      TetMesh mesh = tetrahedralize_once(input, attempts[k], &st);
+      if (k > 0) {
+        st.retries = static_cast<std::int64_t>(k);
+        st.retried_along_lines = attempts[k].covered_faces_along_lines && !options.covered_faces_along_lines;
+        st.bsp_candidate_shift = static_cast<std::int64_t>(attempts[k].bsp_candidate_shift);
+        const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
+        st.seconds_by_stage["first_run"] = total - st.seconds_total;  // every failed attempt
+        st.seconds_total = total;
+      }
+      if (stats) *stats = st;
+      return mesh;
+    } catch (const MeshingError& e) {
+      if (k + 1 == attempts.size() || e.code() != ErrorCode::kInternal || e.stage() != "steiner") throw;
+      if (options.progress) options.progress("retrying: " + std::string(e.what()), 0);
+    }
   }
 }
 

@@ -4,6 +4,8 @@
 //   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--reorient]
 //               [--progress] [--write STEM]
 //
+// --bsp-shift K: score the BSP's sampled candidate planes shifted by K (another partition; what the
+//   core retries with, after --along-lines, when its Steiner removal gets stuck).
 // --along-lines: refine the faces on input planes along whole input edge lines (the fallback
 //   tetrahedralize() uses by itself when the Steiner removal gets stuck).
 // --progress: print each stage and its percentage to stderr as it goes.
@@ -29,7 +31,7 @@ using namespace bsptet;
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--reorient] "
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--bsp-shift K] [--reorient] "
                  "[--progress] [--write STEM]\n",
                  argv[0]);
     return 2;
@@ -42,6 +44,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
     else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
     else if (!std::strcmp(argv[i], "--along-lines")) o.covered_faces_along_lines = true;
+    else if (!std::strcmp(argv[i], "--bsp-shift") && i + 1 < argc) o.bsp_candidate_shift = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--progress"))
       o.progress = [last = std::string(), last_pct = -1](const std::string& stage, double f) mutable {
@@ -64,7 +67,7 @@ int main(int argc, char** argv) {
     const MeshCheckReport r = check_mesh(s, m);
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
                 "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld (recovered %lld) fallback %lld bsp_points %lld seconds %.3f "
-                "min_dihedral %.2f%s\n",
+                "min_dihedral %.2f%s%s\n",
                 argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
                 static_cast<long long>(st.boundary_steiner_before_removal), static_cast<long long>(st.collapsed),
@@ -74,7 +77,8 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.delaunay_recovered_cells),
                 static_cast<long long>(st.delaunay_fallback_cells),
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg,
-                st.retried_along_lines ? " (retried along lines)" : "");
+                st.retried_along_lines ? " (retried along lines)" : "",
+                st.bsp_candidate_shift ? (" (retried with BSP candidate shift " + std::to_string(st.bsp_candidate_shift) + ")").c_str() : "");
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);
     std::printf("\n  steiner removal:");
     for (const auto& [phase, sec] : st.steiner_seconds_by_phase)

@@ -89,6 +89,10 @@ class BspComplex {
   /// `geo` holds the input points as explicit points 0..#P-1 with vertices of the same ids, and
   /// the planes; `tri_plane[t]` is the plane of input triangle t.
   BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane);
+  /// Which sampled candidates choose_plane scores: the i-th is the conflict list's entry
+  /// (i * n / ncand + candidate_shift) mod n. 0 (the default) is the paper's sampling; another
+  /// value gives another, equally valid partition (the mesher's last retry).
+  void set_candidate_shift(std::size_t shift) { candidate_shift_ = shift; }
 
   /// Splits until every cell is a leaf. `cancelled` is polled between splits.
   void build(const std::function<bool()>& cancelled, const std::function<void(double)>& progress);
@@ -143,6 +147,7 @@ class BspComplex {
   void register_edges(Index f);
   void unregister_edges(Index f);
   Index choose_plane(Index c);
+  std::size_t candidate_shift_ = 0;
   /// Splits cell c by plane p; returns false when p does not cut c's interior.
   bool split_cell(Index c, Index p);
   /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),

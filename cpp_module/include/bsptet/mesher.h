@@ -35,6 +35,8 @@ struct MeshOptions {
   /// 6; bsp_complex.h refine_covered_faces_along_lines) instead of one piece per input triangle.
   /// tetrahedralize() retries with it by itself when the Steiner removal gets stuck.
   bool covered_faces_along_lines = false;
+  /// BspComplex::set_candidate_shift for the BSP's plane choice (0: the paper's sampling).
+  std::size_t bsp_candidate_shift = 0;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;
   /// Called with (stage, fraction in [0, 1]); may be empty.
@@ -51,9 +53,13 @@ struct MeshStats {
   std::int64_t apex_cells = 0, pulled_cells = 0;
   std::int64_t delaunay_cells = 0, delaunay_recovered_cells = 0, delaunay_fallback_cells = 0;  ///< CellTets
   std::int64_t exact_fallbacks = 0;
-  /// 1 when the first run's Steiner removal got stuck and the mesh comes from a second run with
-  /// MeshOptions::covered_faces_along_lines (its seconds are in seconds_by_stage["first_run"]).
+  /// 1 when the first run's Steiner removal got stuck and the mesh comes from the retry with
+  /// MeshOptions::covered_faces_along_lines (the failed attempts' seconds are in
+  /// seconds_by_stage["first_run"]).
   std::int64_t retried_along_lines = 0;
+  /// How many attempts failed before the mesh was made (tetrahedralize's retries: 0, along lines,
+  /// then candidate shifts 1 and 2), and the BSP candidate shift of the attempt that made it.
+  std::int64_t retries = 0, bsp_candidate_shift = 0;
   std::map<std::string, double> seconds_by_stage;
   /// The Steiner removal's phases (SteinerRemovalStats::seconds_by_phase, removed_by_phase).
   std::map<std::string, double> steiner_seconds_by_phase;
