@@ -651,19 +651,13 @@ void BspComplex::refine_covered_faces() {
     const Index other = e[0] == t ? e[1] : e[0];
     return other < 0 || tri_plane_[other] != tri_plane_[t];
   };
-  std::vector<Index> work = faces_on_input_planes();
-  while (!work.empty()) {
-    const Index f = work.back();
-    work.pop_back();
-    Sign ns = Sign::kZero;
-    const int axis = geo_.projection_axis(faces_[f].plane, &ns);
-    const int fo = to_int(ns);
+  visit_faces_on_input_planes([&](Index f, int axis, int fo) -> Index {
     std::vector<Index> over;
     for (Index t : faces_[f].coplanar)
       if (face_overlaps_triangle(f, t, axis, fo)) over.push_back(t);
     if (over.empty()) {
       faces_[f].coplanar.clear();
-      continue;
+      return -1;
     }
     // Where the plane's part of the surface ends inside f, split f along that edge's line: then
     // each half is covered entirely or not at all, whatever the triangles inside it.
@@ -674,32 +668,21 @@ void BspComplex::refine_covered_faces() {
         const Index a = triangle_vertex(over[j], k), b = triangle_vertex(over[j], (k + 1) % 3);
         if (segment_crosses_face(f, a, b, axis, fo)) cut_a = a, cut_b = b;
       }
-    if (cut_a >= 0) {
-      const auto [i0, i1] = split_face_in_plane(f, edge_plane(cut_a, cut_b, faces_[f].plane));
-      work.push_back(i1);
-      work.push_back(i0);
-      if (debug_checks_) check_consistency();
-      continue;
-    }
+    if (cut_a >= 0) return edge_plane(cut_a, cut_b, faces_[f].plane);
     // f lies in the union of the triangles it overlaps (no patch boundary crosses its interior):
     // one face per triangle, f ∩ t.
     if (over.size() == 1) {
       faces_[f].coplanar = over;
-      continue;
+      return -1;
     }
     overlay_covered_face(f, over, axis, fo);
     if (debug_checks_) check_consistency();
-  }
+    return -1;
+  });
 }
 
 void BspComplex::refine_covered_faces_along_lines() {
-  std::vector<Index> work = faces_on_input_planes();
-  while (!work.empty()) {
-    const Index f = work.back();
-    work.pop_back();
-    Sign ns = Sign::kZero;
-    const int axis = geo_.projection_axis(faces_[f].plane, &ns);
-    const int fo = to_int(ns);
+  visit_faces_on_input_planes([&](Index f, int axis, int fo) -> Index {
     Index cover = -1;
     for (Index t : faces_[f].coplanar)
       if (face_overlaps_triangle(f, t, axis, fo)) {
@@ -708,7 +691,7 @@ void BspComplex::refine_covered_faces_along_lines() {
       }
     if (cover < 0) {
       faces_[f].coplanar.clear();
-      continue;
+      return -1;
     }
     // Contained in the covering triangle? Otherwise split along an edge of it that crosses f.
     const Index tv[3] = {triangle_vertex(cover, 0), triangle_vertex(cover, 1), triangle_vertex(cover, 2)};
@@ -725,9 +708,22 @@ void BspComplex::refine_covered_faces_along_lines() {
     }
     if (cut_edge < 0) {
       faces_[f].coplanar = {cover};
-      continue;
+      return -1;
     }
-    const auto [i0, i1] = split_face_in_plane(f, edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane));
+    return edge_plane(tv[cut_edge], tv[(cut_edge + 1) % 3], faces_[f].plane);
+  });
+}
+
+void BspComplex::visit_faces_on_input_planes(const std::function<Index(Index, int, int)>& visit) {
+  std::vector<Index> work = faces_on_input_planes();
+  while (!work.empty()) {
+    const Index f = work.back();
+    work.pop_back();
+    Sign ns = Sign::kZero;
+    const int axis = geo_.projection_axis(faces_[f].plane, &ns);
+    const Index along = visit(f, axis, to_int(ns));
+    if (along < 0) continue;
+    const auto [i0, i1] = split_face_in_plane(f, along);
     work.push_back(i1);
     work.push_back(i0);
     if (debug_checks_) check_consistency();

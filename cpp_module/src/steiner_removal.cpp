@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include "bsptet/errors.h"
 #include "bsptet/predicates.h"
@@ -1142,7 +1143,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
         if (known != failed_collapse.end() &&
             mesh.signature(v, known->second.neighbours) == known->second.signature)
           continue;
-        const std::vector<Index> nbrs = mesh.neighbours(v);
+        std::vector<Index> nbrs = mesh.neighbours(v);
         const auto sig = mesh.signature(v, nbrs);
         const std::vector<Index> lv = mesh.labels(v);
         bool done = false;
@@ -1154,7 +1155,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
             break;
           }
         }
-        if (!done) failed_collapse[v] = FailedCollapse{sig, nbrs};
+        if (!done) failed_collapse[v] = FailedCollapse{sig, std::move(nbrs)};
       }
       if (!changed) break;
     }

@@ -170,6 +170,11 @@ class BspComplex {
   std::array<Index, 2> split_face_in_plane(Index f, Index q);
   /// Live faces that may overlap input triangles of their plane, as a work stack (lowest id on top).
   std::vector<Index> faces_on_input_planes() const;
+  /// The loop of both refinements of the covered faces: visits every face of
+  /// faces_on_input_planes(), and both halves of every split, as visit(f, axis, face_orientation)
+  /// (f's projection axis and the sign of its plane's normal along it). A visit returns the plane to
+  /// split f along (split_face_in_plane; the halves are visited next), or -1 when f is done.
+  void visit_faces_on_input_planes(const std::function<Index(Index, int, int)>& visit);
   /// In the face lists of f's cells (but `skip_cell`), f becomes ids[0] and ids[1..] are appended.
   void substitute_face(Index f, const std::vector<Index>& ids, Index skip_cell = -1);
   /// Replaces face f by `pieces` (same plane and cells) in both of its cells.
