@@ -33,18 +33,29 @@ inline void kept_axes(int axis, int& u, int& v) {
 // subnormals; no overflow allowed), a product by its fma residual (exact when the operands are far
 // from underflow or one is zero). When every operation is exact the double result is the exact
 // value, and its sign is the sign of the determinant.
+// Knuth's TwoSum: x + y == a + b exactly, x = fl(a + b) (any finite operands, subnormals too).
+inline void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double bv = x - a, av = x - bv;
+  y = (a - av) + (b - bv);
+}
+// TwoProduct: x + y == a * b exactly when the residual y does not underflow.
+inline void two_product(double a, double b, double& x, double& y) {
+  x = a * b;
+  y = std::fma(a, b, -x);
+}
 inline bool exact_diff(double a, double b, double& out) {
-  out = a - b;
-  if (!std::isfinite(out)) return false;
-  const double bb = out - a;
-  return (a - (out - bb)) + (-b - bb) == 0;
+  double err;
+  two_sum(a, -b, out, err);
+  return std::isfinite(out) && err == 0;
 }
 inline bool exact_prod(double a, double b, double& out) {
-  out = a * b;
+  double err;
+  two_product(a, b, out, err);
   if (a == 0 || b == 0) return true;
   constexpr double kTiny = 0x1p-400;  // both above: the residual is a multiple of 2^-904, representable
   if (!std::isfinite(out) || std::fabs(a) < kTiny || std::fabs(b) < kTiny) return false;
-  return std::fma(a, b, -out) == 0;
+  return err == 0;
 }
 
 // sign(orient2d) when its double evaluation is exact; false otherwise.
@@ -79,16 +90,7 @@ bool orient3d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, cons
 // is the sign of its last (largest) component. TwoSum is exact for any finite operands (with
 // subnormals); TwoProduct (fma residual) is exact when the product's residual does not underflow,
 // which orient3d_expansion guarantees by its range check. Zero components are dropped, so an
-// expansion equal to zero is the single component 0.
-inline void two_sum(double a, double b, double& x, double& y) {
-  x = a + b;
-  const double bv = x - a, av = x - bv;
-  y = (a - av) + (b - bv);
-}
-inline void two_product(double a, double b, double& x, double& y) {
-  x = a * b;
-  y = std::fma(a, b, -x);
-}
+// expansion equal to zero is the single component 0. (two_sum, two_product: above.)
 // h = e + b (h may not alias e). Returns h's length.
 int grow_expansion(const double* e, int n, double b, double* h) {
   double q = b;
