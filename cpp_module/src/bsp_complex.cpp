@@ -17,6 +17,21 @@ BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::v
 }
 
 Index BspComplex::new_face(BspFace f) {
+  f.has_box = !f.verts.empty();
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (Index v : f.verts) {
+    const std::array<Interval, 3>* b = geo_.vertex_box(v);
+    if (!b) {
+      f.has_box = false;
+      break;
+    }
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], (*b)[k].lo());
+      hi[k] = std::max(hi[k], (*b)[k].hi());
+    }
+  }
+  if (f.has_box)
+    for (int k = 0; k < 3; ++k) f.box[k] = Interval(lo[k], hi[k]);
   faces_.push_back(std::move(f));
   const Index id = static_cast<Index>(faces_.size() - 1);
   register_edges(id);
@@ -230,32 +245,52 @@ std::array<Index, 2> BspComplex::split_face(Index f, Index q, VertexSigns& sign)
 }
 
 bool BspComplex::split_cell(Index c, Index p) {
-  // 1. Classify the cell's vertices.
+  // 1. Classify the cell's vertices. A face whose box is strictly on one side of p is not looked
+  // at vertex by vertex (on a long chain of peeling splits most faces are far from the plane):
+  // face_side is +1 / -1 for those, 0 for the faces whose vertices were decided.
   VertexSigns& sign = signs_;
   sign.reset();
   bool pos = false, neg = false;
-  for (Index f : cells_[c].faces)
-    for (Index v : faces_[f].verts)
+  const std::vector<Index>& faces = cells_[c].faces;
+  std::vector<signed char> face_side(faces.size(), 0);
+  for (std::size_t fi = 0; fi < faces.size(); ++fi) {
+    const BspFace& face = faces_[faces[fi]];
+    if (face.has_box) {
+      const Sign bs = geo_.side_of_box(p, face.box);
+      if (bs != Sign::kZero) {
+        face_side[fi] = bs == Sign::kPositive ? 1 : -1;
+        pos = pos || bs == Sign::kPositive;
+        neg = neg || bs == Sign::kNegative;
+        continue;
+      }
+    }
+    for (Index v : face.verts)
       if (!sign.count(v)) {
         const int s = to_int(geo_.side(p, v));
         sign[v] = s;
         pos = pos || s > 0;
         neg = neg || s < 0;
       }
+  }
   if (!pos || !neg) return false;
 
   // 2. Cut the crossing edges (for every face that uses them: conformity).
-  for (std::size_t fi = 0; fi < cells_[c].faces.size(); ++fi) {
-    const Index f = cells_[c].faces[fi];
-    cut_crossing_edges(f, p, sign);
-  }
+  for (std::size_t fi = 0; fi < faces.size(); ++fi)
+    if (face_side[fi] == 0) cut_crossing_edges(faces[fi], p, sign);
 
   // 3. Split the crossing faces, for both of their cells.
   const Index cneg = static_cast<Index>(cells_.size());
   cells_.push_back({});
   std::vector<Index> pos_faces, neg_faces;
+  std::vector<char> decided_pos;  // per pos_faces entry: were its vertices decided?
   const std::vector<Index> old_faces = cells_[c].faces;
-  for (Index f : old_faces) {
+  for (std::size_t fi = 0; fi < old_faces.size(); ++fi) {
+    const Index f = old_faces[fi];
+    if (face_side[fi] != 0) {
+      (face_side[fi] > 0 ? pos_faces : neg_faces).push_back(f);
+      if (face_side[fi] > 0) decided_pos.push_back(0);
+      continue;
+    }
     bool fp = false, fn = false;
     for (Index v : faces_[f].verts) {
       fp = fp || sign[v] > 0;
@@ -265,9 +300,11 @@ bool BspComplex::split_cell(Index c, Index p) {
       const auto [ip, in] = split_face(f, p, sign);
       substitute_face(f, {ip, in}, c);  // the neighbour across f gets both halves
       pos_faces.push_back(ip);
+      decided_pos.push_back(1);
       neg_faces.push_back(in);
     } else if (fp) {
       pos_faces.push_back(f);
+      decided_pos.push_back(1);
     } else if (fn) {
       neg_faces.push_back(f);
     } else {
@@ -277,8 +314,11 @@ bool BspComplex::split_cell(Index c, Index p) {
 
   // 4. The new face on p: chain the zero edges of the positive half, each traversed as the
   // outward cycle of its face (as stored when the cell is on the face's negative side).
+  // (A face strictly on the positive side has no vertex on p.)
   std::unordered_map<Index, Index> next;
-  for (Index f : pos_faces) {
+  for (std::size_t pi = 0; pi < pos_faces.size(); ++pi) {
+    if (!decided_pos[pi]) continue;
+    const Index f = pos_faces[pi];
     std::vector<Index> v = faces_[f].verts;
     if (faces_[f].cell[1] != c) std::reverse(v.begin(), v.end());
     for (std::size_t i = 0; i < v.size(); ++i) {

@@ -227,6 +227,13 @@ Sign ImplicitGeometry::side(Index p, Index v) {
   return to_sign(se);
 }
 
+Sign ImplicitGeometry::side_of_box(Index p, const std::array<Interval, 3>& b) {
+  prepare_plane(p);
+  const PlaneCache& c = plane_cache_[p];
+  const int s = (c.n_iv[0] * b[0] + c.n_iv[1] * b[1] + c.n_iv[2] * b[2] - c.d_iv).certain_sign();
+  return s > 0 ? Sign::kPositive : s < 0 ? Sign::kNegative : Sign::kZero;
+}
+
 Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)

@@ -218,6 +218,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   t0 = Clock::now();
   SteinerRemovalOptions so;
   so.allow_boundary_steiner = options.allow_boundary_steiner;
+  so.interior_work_per_point = options.steiner_effort;
   so.cancelled = options.cancelled;
   so.progress = [&](double f) { progress("removing Steiner points", f); };
   SteinerRemovalStats ss;

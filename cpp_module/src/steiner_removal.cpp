@@ -184,7 +184,8 @@ double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R
 // cavity that grows keeps most of its boundary faces, which need not be decided again.
 class SeesFace {
  public:
-  SeesFace(ImplicitGeometry& geo, Index apex, bool remember) : geo_(geo), apex_(apex), remember_(remember) {}
+  SeesFace(ImplicitGeometry& geo, Index apex, bool remember, std::int64_t* work)
+      : geo_(geo), apex_(apex), remember_(remember), work_(work) {}
   bool operator()(const std::array<Index, 3>& f) {
     if (!remember_) return decide(f);
     auto it = known_.find(f);
@@ -193,7 +194,10 @@ class SeesFace {
   }
 
  private:
-  bool decide(const std::array<Index, 3>& f) { return geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive; }
+  bool decide(const std::array<Index, 3>& f) {
+    ++*work_;
+    return geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive;
+  }
   struct Hash {
     std::size_t operator()(const std::array<Index, 3>& f) const {
       std::uint64_t h = static_cast<std::uint32_t>(f[0]);
@@ -205,6 +209,7 @@ class SeesFace {
   ImplicitGeometry& geo_;
   Index apex_;
   bool remember_;
+  std::int64_t* work_;
   std::unordered_map<std::array<Index, 3>, bool, Hash> known_;
 };
 
@@ -304,6 +309,7 @@ class TetComplex {
       if (std::find(t.begin(), t.end(), u) != t.end()) continue;
       for (Index& x : t)
         if (x == v) x = u;
+      ++work;
       if (geo_.orient3d(t[0], t[1], t[2], t[3]) != Sign::kPositive) return false;
       repl.push_back(t);
     }
@@ -331,6 +337,8 @@ class TetComplex {
   std::size_t max_cavity = 4000;  ///< tets in a grown cavity, at most
   int deep_grow_limit = 64;  ///< cavity growth steps per deep candidate (relocate; 0: no deep candidates)
   std::size_t max_candidates = 1000;
+  /// Exact orientation tests made so far (the work measure of the phases' budgets).
+  std::int64_t work = 0;
   /// Removes v and the Steiner points `also` (any of them may be on the surface) and cones their
   /// cavity from one new double point w (header comment: RELOCATE). The surface faces that touch a
   /// removed point are re-triangulated per input triangle: the region's boundary cycle, removed
@@ -628,7 +636,7 @@ class TetComplex {
       std::vector<std::array<Index, 4>> repl;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
-      SeesFace sees(geo_, wid, max_grow > 0);
+      SeesFace sees(geo_, wid, max_grow > 0, &work);
       for (int grow = 0; grow <= max_grow; ++grow) {
         // Cone from w; every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
@@ -758,7 +766,7 @@ class TetComplex {
       if (it != apexes.end()) return it->second;
       std::vector<Index> out;
       for (Index p : verts)
-        if (p != f[0] && p != f[1] && p != f[2] && geo_.orient3d(f[0], f[2], f[1], p) == Sign::kPositive)
+        if (p != f[0] && p != f[1] && p != f[2] && (++work, geo_.orient3d(f[0], f[2], f[1], p) == Sign::kPositive))
           out.push_back(p);
       return apexes.emplace(f, std::move(out)).first->second;
     };
@@ -844,7 +852,7 @@ class TetComplex {
     std::vector<Index> cav = star_sorted_;
     std::vector<std::array<Index, 4>> repl;
     std::vector<FacePair> boundary = star_boundary_;
-    SeesFace sees(geo_, u, max_grow > 0);
+    SeesFace sees(geo_, u, max_grow > 0, &work);
     for (int grow = 0; grow <= max_grow; ++grow) {
       repl.clear();
       std::vector<Index> add;
@@ -944,6 +952,7 @@ class TetComplex {
       // The triangle on edge (poly[0], poly[m-1]) with apex poly[k].
       for (std::size_t k = 1; k + 1 < m; ++k) {
         const Index p = poly[0], q = poly[k], r = poly[m - 1];
+        work += 2;
         if (geo_.orient3d(p, q, r, x) != Sign::kPositive || geo_.orient3d(p, r, q, v) != Sign::kPositive) continue;
         const std::size_t mark = repl.size();
         repl.push_back({p, q, r, x});
@@ -1114,6 +1123,20 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     st.seconds_by_phase[phase] += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     st.removed_by_phase[phase] += before - static_cast<std::int64_t>(steiner_vertices().size());
   };
+  // The optional phases (merge .. retetrahedralize: interior Steiner points may stay) give each
+  // point at most options.interior_work_per_point exact orientation tests in all, so that a few
+  // points no local operation removes cannot cost minutes (a cube-sphere of 10^4 triangles spent
+  // 12 s in edge removals for 4 points). Counted in tests, not seconds: deterministic.
+  std::unordered_map<Index, std::int64_t> spent;
+  auto affordable = [&](Index v) {
+    return options.interior_work_per_point <= 0 || spent[v] < options.interior_work_per_point;
+  };
+  auto charged = [&](Index v, auto&& attempt) {
+    const std::int64_t w0 = mesh.work;
+    const bool ok = attempt();
+    spent[v] += mesh.work - w0;
+    return ok;
+  };
   {
     const auto sv = steiner_vertices();
     st.steiner_before = static_cast<std::int64_t>(sv.size());
@@ -1267,7 +1290,8 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
         const auto sig = mesh.signature(z, ring);
         const auto known = failed_merge.find(z);
         if (known != failed_merge.end() && known->second == sig) continue;
-        if (!mesh.relocate(z, ring)) failed_merge[z] = sig;
+        if (!affordable(z)) continue;
+        if (!charged(z, [&] { return mesh.relocate(z, ring); })) failed_merge[z] = sig;
       }
       if (mesh.merged == merged_before) break;
       collapse_passes(0.8 + 0.03 * pass, 0.83 + 0.03 * pass);
@@ -1283,11 +1307,13 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       for (Index v : steiner_vertices()) {
         check_cancel();
         if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
-        for (Index u : mesh.neighbours(v))
-          if (mesh.cone_from_vertex(v, u, 6, 400)) {
+        for (Index u : mesh.neighbours(v)) {
+          if (!affordable(v)) break;
+          if (charged(v, [&] { return mesh.cone_from_vertex(v, u, 6, 400); })) {
             ++removed;
             break;
           }
+        }
       }
       st.collapsed += removed;
       if (removed == 0 && mesh.merged == merged_before) break;
@@ -1301,7 +1327,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       check_cancel();
       if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
       bool gone = false;
-      for (int flips = 0; flips < 64 && !gone; ++flips) {
+      for (int flips = 0; flips < 64 && !gone && affordable(v); ++flips) {
         std::vector<std::pair<std::size_t, Index>> by_ring;
         for (Index x : mesh.neighbours(v)) {
           std::size_t ring = 0;
@@ -1314,10 +1340,10 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
         std::sort(by_ring.begin(), by_ring.end());
         bool flipped = false;
         for (const auto& [ring, x] : by_ring)
-          if ((flipped = mesh.remove_edge(v, x))) break;
+          if ((flipped = charged(v, [&] { return mesh.remove_edge(v, x); }))) break;
         if (!flipped) break;
         for (Index u : mesh.neighbours(v))
-          if (mesh.try_substitute(v, u) || mesh.cone_from_vertex(v, u, 6, 400)) {
+          if (charged(v, [&] { return mesh.try_substitute(v, u) || mesh.cone_from_vertex(v, u, 6, 400); })) {
             gone = true;
             ++st.collapsed;
             break;
@@ -1340,8 +1366,8 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       }
       const std::size_t k = std::min<std::size_t>(48, near.size());
       std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
-      for (std::size_t i = 0; i < k; ++i)
-        if (mesh.cone_from_vertex(v, near[i].second, 24, 2000)) {
+      for (std::size_t i = 0; i < k && affordable(v); ++i)
+        if (charged(v, [&] { return mesh.cone_from_vertex(v, near[i].second, 24, 2000); })) {
           ++st.collapsed;
           break;
         }
@@ -1353,8 +1379,8 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     for (Index v : steiner_vertices()) {
       check_cancel();
       if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
-      for (int layers = 0; layers <= 5; ++layers)
-        if (mesh.retetrahedralize(v, layers, 120, 5000)) {
+      for (int layers = 0; layers <= 5 && affordable(v); ++layers)
+        if (charged(v, [&] { return mesh.retetrahedralize(v, layers, 120, 5000); })) {
           ++st.collapsed;
           break;
         }

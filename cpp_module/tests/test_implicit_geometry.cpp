@@ -118,3 +118,57 @@ TEST(ImplicitGeometry, Orient3dWithTpiVerticesMatchesExplicit) {
   EXPECT_GT(zeros, 100);
   EXPECT_LT(zeros, 1900);
 }
+
+// side_of_box is a filter: when it decides, every vertex inside the box is strictly on that side
+// (checked against the exact side() of explicit and TPI vertices in the box), and it never decides
+// for a box the plane passes through. Boxes from TPI vertices' own interval boxes, as BspComplex
+// builds them for its faces.
+TEST(ImplicitGeometry, SideOfBoxNeverContradictsExactSide) {
+  const unsigned seed = 4242u;
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int decided = 0, undecided = 0;
+  for (int it = 0; it < 400; ++it) {
+    const double scale = it % 2 ? 1e-3 : 1e3;
+    std::vector<Vec3> pts;
+    for (int k = 0; k < 15; ++k) pts.push_back({U(rng) * scale, U(rng) * scale, U(rng) * scale});
+    ImplicitGeometry geo(pts);
+    for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+    std::vector<Index> planes;
+    for (int k = 0; k < 5; ++k) planes.push_back(geo.add_plane(3 * k, 3 * k + 1, 3 * k + 2));
+    // Vertices: some explicit points and the TPI vertices of plane triples.
+    std::vector<Index> verts = {0, 4, 8};
+    for (int a = 0; a < 5; ++a)
+      for (int b = a + 1; b < 5; ++b)
+        for (int c = b + 1; c < 5; ++c) verts.push_back(geo.add_tpi_vertex(planes[a], planes[b], planes[c]));
+    // Boxes over a few vertices each (a face's box).
+    for (std::size_t start = 0; start + 3 <= verts.size(); start += 2) {
+      double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      bool ok = true;
+      for (std::size_t i = start; i < start + 3; ++i) {
+        const auto* b = geo.vertex_box(verts[i]);
+        if (!b) {
+          ok = false;
+          break;
+        }
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], (*b)[k].lo()), hi[k] = std::max(hi[k], (*b)[k].hi());
+      }
+      if (!ok) continue;
+      const std::array<Interval, 3> box = {Interval(lo[0], hi[0]), Interval(lo[1], hi[1]), Interval(lo[2], hi[2])};
+      for (Index pl : planes) {
+        const Sign bs = geo.side_of_box(pl, box);
+        if (bs == Sign::kZero) {
+          ++undecided;
+          continue;
+        }
+        ++decided;
+        for (std::size_t i = start; i < start + 3; ++i)
+          ASSERT_EQ(geo.side(pl, verts[i]), bs) << "iteration " << it << " seed " << seed;
+      }
+    }
+  }
+  std::printf("decided %d, undecided %d\n", decided, undecided);
+  EXPECT_GT(decided, 100) << "the filter must decide often enough to matter";
+  EXPECT_GT(undecided, 100) << "the test must include boxes the plane passes through";
+}

@@ -180,3 +180,32 @@ TEST(Mesher, ManyTrianglesOnOnePlaneStayLinear) {
     EXPECT_GT(lines.bsp_points, st.bsp_points);
   }
 }
+
+// The effort bound of the optional Steiner removal phases (MeshOptions::steiner_effort): with
+// almost no effort the interior Steiner points that need the expensive phases stay, the mesh is
+// still fully valid with none on the surface, and it is the same mesh every time; without a bound
+// there are at most as many.
+TEST(Mesher, SteinerEffortBoundKeepsTheMeshValid) {
+  const SurfaceMesh s = read_off(data("corpus/joint.off"));
+  MeshOptions little;
+  little.steiner_effort = 1;
+  MeshStats st_little, st_again, st_full;
+  const TetMesh m = tetrahedralize(s, little, &st_little);
+  const TetMesh again = tetrahedralize(s, little, &st_again);
+  MeshOptions full;
+  full.steiner_effort = 0;
+  const TetMesh mf = tetrahedralize(s, full, &st_full);
+  std::printf("joint: effort 1: %lld Steiner points, %lld tets; unbounded: %lld, %lld\n",
+              (long long)st_little.steiner_points, (long long)st_little.tets, (long long)st_full.steiner_points,
+              (long long)st_full.tets);
+  for (const TetMesh* mesh : {&m, &mf}) {
+    const MeshCheckReport r = check_mesh(s, *mesh);
+    EXPECT_TRUE(r.valid);
+    for (const auto& msg : r.messages) ADD_FAILURE() << msg;
+    EXPECT_EQ(r.boundary_steiner_points, 0);
+  }
+  EXPECT_EQ(m.xyz, again.xyz);
+  EXPECT_EQ(m.tet, again.tet);
+  EXPECT_GE(st_little.steiner_points, st_full.steiner_points);
+  EXPECT_GT(st_little.steiner_points, st_full.steiner_points) << "joint needs the optional phases";
+}

@@ -6,6 +6,8 @@
 //
 // --bsp-shift K: score the BSP's sampled candidate planes shifted by K (another partition; what the
 //   core retries with, after --along-lines, when its Steiner removal gets stuck).
+// --steiner-effort N: exact orientation tests the core may spend on removing one interior Steiner
+//   point (0: no limit).
 // --along-lines: refine the faces on input planes along whole input edge lines (the fallback
 //   tetrahedralize() uses by itself when the Steiner removal gets stuck).
 // --progress: print each stage and its percentage to stderr as it goes.
@@ -31,7 +33,7 @@ using namespace bsptet;
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--bsp-shift K] [--reorient] "
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
                  "[--progress] [--write STEM]\n",
                  argv[0]);
     return 2;
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
     else if (!std::strcmp(argv[i], "--along-lines")) o.covered_faces_along_lines = true;
     else if (!std::strcmp(argv[i], "--bsp-shift") && i + 1 < argc) o.bsp_candidate_shift = std::strtoul(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--steiner-effort") && i + 1 < argc) o.steiner_effort = std::strtoll(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
     else if (!std::strcmp(argv[i], "--progress"))
       o.progress = [last = std::string(), last_pct = -1](const std::string& stage, double f) mutable {

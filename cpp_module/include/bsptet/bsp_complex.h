@@ -65,6 +65,11 @@ struct BspFace {
   Index cell[2] = {-1, -1};     ///< [0] positive side, [1] negative side, -1 outside the box
   std::vector<Index> coplanar;  ///< input triangles on this plane that may overlap the face
   bool alive = true;
+  /// Intervals enclosing every vertex (set by new_face; still valid when a vertex is inserted on an
+  /// edge or replaced by one at the same place), so that a split can skip a face far from its
+  /// plane without deciding each vertex. has_box is false when a vertex had no interval box.
+  bool has_box = false;
+  std::array<Interval, 3> box;
 };
 
 struct BspCell {

@@ -59,6 +59,11 @@ class ImplicitGeometry {
 
   /// sign(n . (v - a)) for plane (a, b, c), exact.
   Sign side(Index plane, Index v);
+  /// A filter for many vertices at once: POSITIVE (NEGATIVE) when every point of the box (intervals
+  /// of x, y, z) is strictly on that side of the plane, ZERO when that is not certain. No exact step.
+  Sign side_of_box(Index plane, const std::array<Interval, 3>& box);
+  /// Intervals enclosing vertex v's coordinates (x, y, z), or nullptr when none are available.
+  const std::array<Interval, 3>* vertex_box(Index v) { return box(v); }
   /// Exact orient3d of four vertices of any kind (predicates.h convention: POSITIVE when d lies on
   /// the side of the right-hand normal of (a, b, c)). Explicit-only calls use the double predicate.
   Sign orient3d(Index a, Index b, Index c, Index d);
