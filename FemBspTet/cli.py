@@ -188,6 +188,7 @@ def _cmd_mesh(args):
                      "surface_points": args.surface_points,
                      "order": args.order,
                      "allow_boundary_steiner": args.allow_boundary_steiner,
+                     "steiner_effort": args.steiner_effort,
                      "reorient": args.reorient,
                      "max_memory": args.max_memory_bytes},
             progress=progress)
@@ -343,6 +344,16 @@ def _cmd_benchmark(args):
     return 0
 
 
+def _non_negative_int(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
+    return value
+
+
 def build_parser():
     p = argparse.ArgumentParser(
         prog="fembsptet",
@@ -375,6 +386,9 @@ def build_parser():
     m.add_argument("--allow-boundary-steiner", action="store_true",
                    help="keep Steiner points on the surface where they are exactly doubles "
                         "(default: none on the surface, as tetgen -Y)")
+    m.add_argument("--steiner-effort", type=_non_negative_int, default=None, metavar="N",
+                   help="exact orientation tests the core may spend removing one interior Steiner "
+                        "point (default 400000; 0: no bound, fewer Steiner points, possibly much slower)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.add_argument("--reorient", action="store_true",

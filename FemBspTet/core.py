@@ -135,13 +135,27 @@ def to_second_order(mesh: TetMesh) -> TetMesh:
     return TetMesh(np.vstack([mesh.points, mids]), np.hstack([tets, mid_ids]), mesh.source, dict(mesh.extra))
 
 
+def _effort(options):
+    """The ``steiner_effort`` keyword for the native call (absent: the core's default)."""
+    from .errors import InputError
+
+    effort = options.get("steiner_effort")
+    if effort is None:
+        return {}
+    if isinstance(effort, bool) or not isinstance(effort, int) or effort < 0:
+        raise InputError(f"steiner_effort must be an integer >= 0 (0: no bound), got {effort!r}")
+    return {"steiner_effort": effort}
+
+
 def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     """Tetrahedralizes the solid(s) bounded by ``surfaces`` (a Surface or a list, one per solid).
 
     BSP-assisted and exact (cpp_module/include/bsptet/mesher.h): the output boundary is the input
     triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is positive.
 
-    ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``order`` (1 or 2),
+    ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``steiner_effort`` (int:
+    exact orientation tests the core may spend removing one interior Steiner point, default
+    400000; 0 = no bound: fewer interior Steiner points, possibly minutes more), ``order`` (1 or 2),
     ``reorient`` (bool, default False: flip inconsistently oriented or inward-facing shells instead
     of refusing them, see :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before
     meshing, a run whose estimated peak memory exceeds it, :class:`MemoryBudgetError`; see
@@ -193,7 +207,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             points, tets, st = native.tetrahedralize(
                 surface.points, surface.triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
-                progress=report, cancel=cancel)
+                progress=report, cancel=cancel, **_effort(options))
         mesh = TetMesh(points, tets, surface.source)
         report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):
@@ -322,7 +336,7 @@ REFINE_OPTIONS = {
 
 #: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
 #: onto these, ``mesh_pipeline.CORE_OPTION_OF``).
-OPTION_NAMES = ("allow_boundary_steiner", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
+OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
 
 
 def _positive_number(name, value, allow_zero=False):

@@ -233,3 +233,25 @@ def test_mesh_bottle_tessellation_is_valid(cli, tmp_path):
     stats = json.loads(stats_file.read_text())
     assert stats["valid"] is True and stats["boundary_steiner_points"] == 0
     assert stats["tets"] > 0
+
+
+def test_mesh_steiner_effort_bounds_the_interior_removal(cli, tmp_path):
+    """``--steiner-effort 1`` leaves the interior Steiner points the expensive phases would take
+    (joint: more of them), still a valid mesh with none on the surface; a bad value is refused."""
+    joint = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "corpus", "joint.off")
+    counts = {}
+    for effort in ("1", "0"):
+        out = tmp_path / f"joint_{effort}.vtu"
+        stats_file = tmp_path / f"joint_{effort}.json"
+        r = run(cli, "mesh", joint, "-o", out, "--stats-json", stats_file, "--quiet", "--steiner-effort", effort)
+        assert r.returncode == 0, r.stderr
+        stats = json.loads(stats_file.read_text())
+        r = run(cli, "check", joint, out, "--json")
+        assert r.returncode == 0, r.stdout
+        report = json.loads(r.stdout)
+        assert report["valid"] is True and report["boundary_steiner_points"] == 0
+        counts[effort] = stats["steiner_points"]
+    assert counts["1"] > counts["0"], counts
+    r = run(cli, "mesh", joint, "-o", tmp_path / "x.vtu", "--steiner-effort", "-3")
+    assert r.returncode == 2 and "steiner-effort" in r.stderr
+    assert not (tmp_path / "x.vtu").exists()

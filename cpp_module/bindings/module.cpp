@@ -148,11 +148,13 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "tetrahedralize",
       [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
-         py::object cancel, bool cone_cells) {
+         py::object cancel, bool cone_cells, std::int64_t steiner_effort) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
         o.cone_cells = cone_cells;
+        if (steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
+        o.steiner_effort = steiner_effort;
         TetMesh mesh;
         MeshStats st;
         run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
@@ -190,9 +192,12 @@ PYBIND11_MODULE(_bsptet, m) {
       },
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("cone_cells") = false,
+      py::arg("steiner_effort") = MeshOptions{}.steiner_effort,
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
-      "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison.");
+      "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison. "
+      "steiner_effort: exact orientation tests the core may spend removing one interior Steiner point "
+      "(0: no bound; MeshOptions::steiner_effort).");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.

@@ -13,6 +13,14 @@ namespace bsptet {
 
 BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane)
     : geo_(geo), surface_(surface), tri_plane_(std::move(tri_plane)) {
+  tri_box_.resize(static_cast<std::size_t>(surface_.num_triangles()));
+  for (Index t = 0; t < surface_.num_triangles(); ++t) {
+    const Vec3 a = surface_.point(triangle_vertex(t, 0)), b = surface_.point(triangle_vertex(t, 1)),
+               c = surface_.point(triangle_vertex(t, 2));
+    tri_box_[t] = {Interval(std::min({a.x, b.x, c.x}), std::max({a.x, b.x, c.x})),
+                   Interval(std::min({a.y, b.y, c.y}), std::max({a.y, b.y, c.y})),
+                   Interval(std::min({a.z, b.z, c.z}), std::max({a.z, b.z, c.z}))};
+  }
   make_box();
 }
 
@@ -113,6 +121,12 @@ void BspComplex::make_box() {
 }
 
 void BspComplex::classify_triangle(Index t, Index p, int& mn, int& mx) {
+  // The triangle's box first (its corners are doubles: the box is exact), then each vertex.
+  const Sign whole = geo_.side_of_box(p, tri_box_[t]);
+  if (whole != Sign::kZero) {
+    mn = mx = to_int(whole);
+    return;
+  }
   mn = 1;
   mx = -1;
   for (int k = 0; k < 3; ++k) {

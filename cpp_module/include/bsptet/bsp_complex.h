@@ -194,6 +194,7 @@ class BspComplex {
   ImplicitGeometry& geo_;
   const SurfaceMesh& surface_;
   std::vector<Index> tri_plane_;
+  std::vector<std::array<Interval, 3>> tri_box_;  ///< each input triangle's (exact) bounding box
   std::vector<BspFace> faces_;
   std::vector<BspCell> cells_;
   std::unordered_map<std::uint64_t, std::vector<Index>> edge_faces_;
