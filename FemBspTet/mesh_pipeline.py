@@ -573,12 +573,23 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
         node_set = set(mesh.tets[e].tolist())
         where = sorted({face_names[g] for f, g in zip(faces.tolist(), tags.tolist())
                         if set(f) <= node_set})
-        flat = ("; the mesh's worst dihedral angle is %.3g degrees: elements next to the "
-                "curved face are thinner than the distance their mid-nodes move onto it"
-                % min_dihedral) if min_dihedral is not None else ""
+        at = " (at %s)" % ", ".join(where) if where else ""
+        if t.shape[1] == 10:
+            flat = ("; the mesh's worst dihedral angle is %.3g degrees: elements next to the "
+                    "curved face are thinner than the distance their mid-nodes move onto it"
+                    % min_dihedral) if min_dihedral is not None else ""
+            raise InternalError(
+                "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
+                "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
+                "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "
+                "on the CAD faces)" % (int(bad.sum()), e, at, flat))
+        flat = ("; the mesh's worst dihedral angle is %.3g degrees" % min_dihedral
+                if min_dihedral is not None else "")
         raise InternalError(
-            "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
-            "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
-            "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "
-            "on the CAD faces)"
-            % (int(bad.sum()), e, " (at %s)" % ", ".join(where) if where else "", flat))
+            "moving the boundary nodes added by the size refinement onto the curved CAD faces "
+            "would invert %d element(s), first tet %d%s%s: the tessellation is farther from the "
+            "CAD surface there than those elements are thick. No mesh was made (nodes left off "
+            "the CAD face would not be found by the constraints). A smaller LinearDeflection "
+            "(a tessellation closer to the CAD faces), a larger CharacteristicLengthMax, or "
+            "CharacteristicLengthMax 0 (no boundary nodes added) avoids it"
+            % (int(bad.sum()), e, at, flat))

@@ -253,3 +253,33 @@ def test_bad_refinement_options_are_input_errors():
         core.tetrahedralize(surface, options={"radius_edge": 0.5})
     with pytest.raises(InputError, match="unknown"):
         core.tetrahedralize(surface, options={"sizes": 1.0})
+
+
+def test_projection_check_names_what_moved_at_each_order():
+    """A boundary node moved through a tet (the chord sag of a curved face) is refused with a
+    message that fits the element order: at order 1 there are no mid-nodes to speak of."""
+    from FemBspTet.errors import InternalError
+    from FemBspTet.mesh_pipeline import check_elements_after_projection
+    from FemBspTet.mesh_types import TetMesh
+
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    tets = np.array([[0, 1, 2, 3]])
+    faces = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    tags = np.array([0, 0, 1, 0])
+    names = {0: "Face1", 1: "Face2"}
+    check_elements_after_projection(TetMesh(points, tets), np.array([3]), faces, tags, names)  # valid
+    points[3] = [0.2, 0.2, -0.5]  # node 3 moved below the opposite face: the tet is inverted
+    with pytest.raises(InternalError) as err:
+        check_elements_after_projection(TetMesh(points, tets), np.array([3]), faces, tags, names,
+                                        min_dihedral=0.5)
+    text = str(err.value)
+    assert "mid-node" not in text and "tet10" not in text
+    assert "would invert 1 element(s), first tet 0" in text and "LinearDeflection" in text
+    assert "Face1" in text and "0.5 degrees" in text
+    # At order 2 the message speaks of the mid-nodes.
+    edges = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
+    mids = np.array([(points[a] + points[b]) / 2 for a, b in edges])
+    tet10 = np.array([[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]])
+    with pytest.raises(InternalError, match="tet10 mid-nodes"):
+        check_elements_after_projection(TetMesh(np.vstack([points, mids]), tet10), np.array([3]),
+                                        faces, tags, names)
