@@ -111,7 +111,9 @@ void BspComplex::make_box() {
       f.cell[0] = -1;  // outward normal: the positive side is outside
       f.cell[1] = 0;
       for (Index c : q) geo_.note_on_plane(c, f.plane);
-      cells_[0].faces.push_back(new_face(std::move(f)));
+      const Index id = new_face(std::move(f));
+      cells_[0].faces.push_back(id);
+      cells_[0].boxes.push_back(face_box(id));
     }
   // Box edges: the two box planes through each.
   for (const auto& [key, users] : edge_faces_) {
@@ -258,19 +260,27 @@ std::array<Index, 2> BspComplex::split_face(Index f, Index q, VertexSigns& sign)
   return {i0, i1};
 }
 
-bool BspComplex::split_cell(Index c, Index p) {
+Index BspComplex::split_cell(Index c, Index p) {
   // 1. Classify the cell's vertices. A face whose box is strictly on one side of p is not looked
   // at vertex by vertex (on a long chain of peeling splits most faces are far from the plane):
   // face_side is +1 / -1 for those, 0 for the faces whose vertices were decided.
   VertexSigns& sign = signs_;
   sign.reset();
   bool pos = false, neg = false;
+  {
+    BspCell& cell = cells_[c];
+    if (cell.boxes.size() != cell.faces.size()) {
+      cell.boxes.clear();
+      for (Index f : cell.faces) cell.boxes.push_back(face_box(f));
+    }
+  }
   const std::vector<Index>& faces = cells_[c].faces;
-  std::vector<signed char> face_side(faces.size(), 0);
+  const std::vector<FaceBox>& boxes = cells_[c].boxes;
+  std::vector<signed char>& face_side = face_side_;
+  face_side.assign(faces.size(), 0);
   for (std::size_t fi = 0; fi < faces.size(); ++fi) {
-    const BspFace& face = faces_[faces[fi]];
-    if (face.has_box) {
-      const Sign bs = geo_.side_of_box(p, face.box);
+    if (boxes[fi].ok) {
+      const Sign bs = geo_.side_of_box(p, boxes[fi].box);
       if (bs != Sign::kZero) {
         face_side[fi] = bs == Sign::kPositive ? 1 : -1;
         pos = pos || bs == Sign::kPositive;
@@ -278,7 +288,7 @@ bool BspComplex::split_cell(Index c, Index p) {
         continue;
       }
     }
-    for (Index v : face.verts)
+    for (Index v : faces_[faces[fi]].verts)
       if (!sign.count(v)) {
         const int s = to_int(geo_.side(p, v));
         sign[v] = s;
@@ -286,7 +296,7 @@ bool BspComplex::split_cell(Index c, Index p) {
         neg = neg || s < 0;
       }
   }
-  if (!pos || !neg) return false;
+  if (!pos || !neg) return -1;
 
   // 2. Cut the crossing edges (for every face that uses them: conformity).
   for (std::size_t fi = 0; fi < faces.size(); ++fi)
@@ -296,13 +306,23 @@ bool BspComplex::split_cell(Index c, Index p) {
   const Index cneg = static_cast<Index>(cells_.size());
   cells_.push_back({});
   std::vector<Index> pos_faces, neg_faces;
+  std::vector<FaceBox> pos_boxes, neg_boxes;
   std::vector<char> decided_pos;  // per pos_faces entry: were its vertices decided?
-  const std::vector<Index> old_faces = cells_[c].faces;
+  const std::vector<Index> old_faces = std::move(cells_[c].faces);
+  const std::vector<FaceBox> old_boxes = std::move(cells_[c].boxes);
+  cells_[c].faces.clear();
+  cells_[c].boxes.clear();
   for (std::size_t fi = 0; fi < old_faces.size(); ++fi) {
     const Index f = old_faces[fi];
     if (face_side[fi] != 0) {
-      (face_side[fi] > 0 ? pos_faces : neg_faces).push_back(f);
-      if (face_side[fi] > 0) decided_pos.push_back(0);
+      if (face_side[fi] > 0) {
+        pos_faces.push_back(f);
+        pos_boxes.push_back(old_boxes[fi]);
+        decided_pos.push_back(0);
+      } else {
+        neg_faces.push_back(f);
+        neg_boxes.push_back(old_boxes[fi]);
+      }
       continue;
     }
     bool fp = false, fn = false;
@@ -314,13 +334,17 @@ bool BspComplex::split_cell(Index c, Index p) {
       const auto [ip, in] = split_face(f, p, sign);
       substitute_face(f, {ip, in}, c);  // the neighbour across f gets both halves
       pos_faces.push_back(ip);
+      pos_boxes.push_back(face_box(ip));
       decided_pos.push_back(1);
       neg_faces.push_back(in);
+      neg_boxes.push_back(face_box(in));
     } else if (fp) {
       pos_faces.push_back(f);
+      pos_boxes.push_back(old_boxes[fi]);
       decided_pos.push_back(1);
     } else if (fn) {
       neg_faces.push_back(f);
+      neg_boxes.push_back(old_boxes[fi]);
     } else {
       throw MeshingError(ErrorCode::kInternal, "bsp", f, "a cell face lies on the splitting plane");
     }
@@ -340,10 +364,13 @@ bool BspComplex::split_cell(Index c, Index p) {
       if (sign[a] == 0 && sign[b] == 0) next[a] = b;
     }
   }
+  // The side with more faces keeps the id c (its faces need no relabelling).
+  const bool neg_keeps = neg_faces.size() > pos_faces.size();
+  const Index pid = neg_keeps ? cneg : c, nid = neg_keeps ? c : cneg;
   BspFace cut;
   cut.plane = p;
-  cut.cell[0] = c;
-  cut.cell[1] = cneg;
+  cut.cell[0] = pid;
+  cut.cell[1] = nid;
   {
     Index start = next.begin()->first;
     for (const auto& kv : next) start = std::min(start, kv.first);  // deterministic start
@@ -375,17 +402,21 @@ bool BspComplex::split_cell(Index c, Index p) {
   const Index cut_id = new_face(std::move(cut));
 
   // 6. The two cells.
-  for (Index f : neg_faces)
+  for (Index f : neg_keeps ? pos_faces : neg_faces)
     for (int side = 0; side < 2; ++side)
       if (faces_[f].cell[side] == c) faces_[f].cell[side] = cneg;
   pos_faces.push_back(cut_id);
   neg_faces.push_back(cut_id);
-  cells_[c].faces = std::move(pos_faces);
-  cells_[c].conflict = std::move(list_pos);
-  cells_[cneg].faces = std::move(neg_faces);
-  cells_[cneg].conflict = std::move(list_neg);
+  pos_boxes.push_back(face_box(cut_id));
+  neg_boxes.push_back(face_box(cut_id));
+  cells_[pid].faces = std::move(pos_faces);
+  cells_[pid].boxes = std::move(pos_boxes);
+  cells_[pid].conflict = std::move(list_pos);
+  cells_[nid].faces = std::move(neg_faces);
+  cells_[nid].boxes = std::move(neg_boxes);
+  cells_[nid].conflict = std::move(list_neg);
   ++stats_.splits;
-  return true;
+  return nid;
 }
 
 void BspComplex::build(const std::function<bool()>& cancelled, const std::function<void(double)>& progress) {
@@ -402,7 +433,8 @@ void BspComplex::build(const std::function<bool()>& cancelled, const std::functi
       continue;
     }
     const Index p = choose_plane(c);
-    if (!split_cell(c, p)) {
+    const Index negative = split_cell(c, p);
+    if (negative < 0) {
       auto& list = cells_[c].conflict;
       const std::size_t before = list.size();
       list.erase(std::remove_if(list.begin(), list.end(), [&](Index t) { return tri_plane_[t] == p; }),
@@ -410,7 +442,9 @@ void BspComplex::build(const std::function<bool()>& cancelled, const std::functi
       done_triangles += static_cast<std::int64_t>(before - list.size());
       continue;
     }
-    work.push_back(static_cast<Index>(cells_.size() - 1));
+    // The negative side next, then the positive one (the order before the ids were chosen by size).
+    work.back() = negative == c ? static_cast<Index>(cells_.size() - 1) : c;
+    work.push_back(negative);
     if (debug_checks_) check_consistency();
     if (progress && (stats_.splits & 255) == 0) progress(std::min(0.99, done_triangles / total));
   }
@@ -538,8 +572,16 @@ void BspComplex::substitute_face(Index f, const std::vector<Index>& ids, Index s
     auto& fl = cells_[c].faces;
     auto it = std::find(fl.begin(), fl.end(), f);
     if (it == fl.end()) throw MeshingError(ErrorCode::kInternal, "bsp", f, "face missing from its cell");
+    const std::size_t at = static_cast<std::size_t>(it - fl.begin());
     *it = ids[0];
     fl.insert(fl.end(), ids.begin() + 1, ids.end());
+    auto& bl = cells_[c].boxes;
+    if (bl.size() + ids.size() - 1 == fl.size()) {  // in step: keep it so
+      bl[at] = face_box(ids[0]);
+      for (std::size_t i = 1; i < ids.size(); ++i) bl.push_back(face_box(ids[i]));
+    } else {
+      bl.clear();  // rebuilt by the next split_cell
+    }
   }
 }
 

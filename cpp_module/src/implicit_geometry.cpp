@@ -230,6 +230,41 @@ Sign ImplicitGeometry::side(Index p, Index v) {
 Sign ImplicitGeometry::side_of_box(Index p, const std::array<Interval, 3>& b) {
   prepare_plane(p);
   const PlaneCache& c = plane_cache_[p];
+  // Bounds of n . x - d over the box in plain doubles, then one error bound for all the rounding:
+  // each of the (at most) 7 operations per bound errs by at most 2^-53 of a partial result, and
+  // every partial result is at most M = sum of the terms' magnitudes, so 2^-50 M covers it; 1e-300
+  // covers underflowing products. A normal component whose interval contains 0 takes the interval
+  // arithmetic below.
+  double lo = 0, hi = 0, mag = 0;
+  bool fast = true;
+  for (int k = 0; k < 3 && fast; ++k) {
+    const double nl = c.n_iv[k].lo(), nh = c.n_iv[k].hi(), xl = b[k].lo(), xh = b[k].hi();
+    double tl, th;
+    if (nl >= 0) {
+      tl = std::min(nl * xl, nh * xl);
+      th = std::max(nl * xh, nh * xh);
+    } else if (nh <= 0) {
+      tl = std::min(nl * xh, nh * xh);
+      th = std::max(nl * xl, nh * xl);
+    } else {
+      fast = false;
+      break;
+    }
+    lo += tl;
+    hi += th;
+    mag += std::max(std::fabs(tl), std::fabs(th));
+  }
+  if (fast) {
+    const double dl = c.d_iv.lo(), dh = c.d_iv.hi();
+    lo -= dh;
+    hi -= dl;
+    mag += std::max(std::fabs(dl), std::fabs(dh));
+    if (!std::isfinite(mag) || !std::isfinite(lo) || !std::isfinite(hi)) return Sign::kZero;
+    const double err = mag * 0x1p-50 + 1e-300;
+    if (lo - err > 0) return Sign::kPositive;
+    if (hi + err < 0) return Sign::kNegative;
+    return Sign::kZero;
+  }
   const int s = (c.n_iv[0] * b[0] + c.n_iv[1] * b[1] + c.n_iv[2] * b[2] - c.d_iv).certain_sign();
   return s > 0 ? Sign::kPositive : s < 0 ? Sign::kNegative : Sign::kZero;
 }

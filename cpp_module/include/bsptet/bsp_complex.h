@@ -72,8 +72,16 @@ struct BspFace {
   std::array<Interval, 3> box;
 };
 
+/// A face's box as a cell keeps it (a copy of BspFace::box, next to the face ids, so that a split
+/// scans its cell's boxes in order instead of visiting every face record).
+struct FaceBox {
+  std::array<Interval, 3> box;
+  bool ok = false;
+};
+
 struct BspCell {
   std::vector<Index> faces;
+  std::vector<FaceBox> boxes;   ///< parallel to faces (rebuilt by split_cell if out of step)
   std::vector<Index> conflict;  ///< input triangles that may cross the interior
   bool alive = true;
 };
@@ -153,8 +161,11 @@ class BspComplex {
   void unregister_edges(Index f);
   Index choose_plane(Index c);
   std::size_t candidate_shift_ = 0;
-  /// Splits cell c by plane p; returns false when p does not cut c's interior.
-  bool split_cell(Index c, Index p);
+  /// Splits cell c by plane p; returns the id of the cell on p's negative side (the other one has
+  /// the other id: the side with more faces keeps c, so fewer faces are relabelled), or -1 when p
+  /// does not cut c's interior.
+  Index split_cell(Index c, Index p);
+  FaceBox face_box(Index f) const { return {faces_[f].box, faces_[f].has_box}; }
   /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),
   /// inserting the new vertex into every face that uses the edge.
   void cut_crossing_edges(Index f, Index q, VertexSigns& sign);
@@ -190,6 +201,7 @@ class BspComplex {
   void overlay_covered_face(Index f, const std::vector<Index>& over, int axis, int face_orientation);
   std::unordered_map<std::uint64_t, Index> edge_planes_;
   VertexSigns signs_;  ///< scratch for split_cell and refine_covered_faces (reset by each)
+  std::vector<signed char> face_side_;  ///< scratch for split_cell
 
   ImplicitGeometry& geo_;
   const SurfaceMesh& surface_;
