@@ -172,3 +172,53 @@ TEST(ImplicitGeometry, SideOfBoxNeverContradictsExactSide) {
   EXPECT_GT(decided, 100) << "the filter must decide often enough to matter";
   EXPECT_GT(undecided, 100) << "the test must include boxes the plane passes through";
 }
+
+// orient3d of three vertices on one known plane and a fourth (side x orient2d in the plane) must
+// agree with the 4 x 4 homogeneous determinant: the same points are built a second time with
+// distinct plane ids for the common plane (same defining points), so no three share a known plane
+// and the general exact path decides. Fourth points near the plane make the filters fail.
+TEST(ImplicitGeometry, Orient3dThroughACommonPlaneMatchesTheGeneralPath) {
+  const unsigned seed = 2027u;
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  int decided_by_exact = 0, zeros = 0;
+  for (int it = 0; it < 300; ++it) {
+    std::vector<Vec3> pts;
+    for (int k = 0; k < 3; ++k) pts.push_back({U(rng), U(rng), U(rng)});  // P
+    for (int k = 0; k < 16; ++k) pts.push_back({U(rng), U(rng), U(rng)});  // others
+    // P': through P's first two points and a point very near P (or on it: an exact zero).
+    const Vec3 &p0 = pts[0], &p1 = pts[1], &p2 = pts[2];
+    const double t = U(rng), e = 1e-13 * U(rng);
+    pts.push_back({p0.x + t * (p2.x - p0.x) + e, p0.y + t * (p2.y - p0.y) - e, p0.z + t * (p2.z - p0.z)});
+    for (int pass = 0; pass < 2; ++pass) {
+      ImplicitGeometry geo(pts);
+      for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+      std::vector<Index> q;
+      for (int k = 0; k < 5; ++k) q.push_back(geo.add_plane(3 + 3 * k, 4 + 3 * k, 5 + 3 * k));
+      const Index pa = geo.add_plane(0, 1, 2);
+      const Index pb = pass == 0 ? pa : geo.add_plane(0, 1, 2), pc = pass == 0 ? pa : geo.add_plane(0, 1, 2);
+      // Every third run the fourth point is on P itself, through a plane id of its own (an exact
+      // zero the known-plane lists do not give away).
+      const Index pnear = it % 3 == 0 ? geo.add_plane(0, 1, 2) : geo.add_plane(0, 1, 19);
+      const Index v1 = geo.add_tpi_vertex(pa, q[0], q[1]), v2 = geo.add_tpi_vertex(pb, q[1], q[2]),
+                  v3 = geo.add_tpi_vertex(pc, q[2], q[3]), w = geo.add_tpi_vertex(pnear, q[3], q[4]);
+      static Sign first[4][4];
+      const std::array<std::array<Index, 4>, 4> orders = {
+          {{v1, v2, v3, w}, {v1, v2, w, v3}, {w, v1, v2, v3}, {v2, w, v3, v1}}};
+      for (int o = 0; o < 4; ++o) {
+        const Sign s = geo.orient3d(orders[o][0], orders[o][1], orders[o][2], orders[o][3]);
+        if (pass == 0) {
+          first[0][o] = s;
+        } else {
+          ASSERT_EQ(s, first[0][o]) << "iteration " << it << " order " << o << " seed " << seed;
+          zeros += s == Sign::kZero;
+        }
+      }
+      if (pass == 1) decided_by_exact += geo.exact_fallbacks() > 0;
+    }
+  }
+  std::printf("runs with exact fallbacks %d, zeros %d\n", decided_by_exact, zeros);
+  EXPECT_GT(decided_by_exact, 100) << "the filters must fail often enough to test the exact paths";
+  EXPECT_GT(zeros, 100);
+}
