@@ -155,7 +155,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
 
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``steiner_effort`` (int:
     exact orientation tests the core may spend removing one interior Steiner point, default
-    400000; 0 = no bound: fewer interior Steiner points, possibly minutes more), ``order`` (1 or 2),
+    1000000; 0 = no bound: fewer interior Steiner points, possibly minutes more), ``order`` (1 or 2),
     ``reorient`` (bool, default False: flip inconsistently oriented or inward-facing shells instead
     of refusing them, see :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before
     meshing, a run whose estimated peak memory exceeds it, :class:`MemoryBudgetError`; see

@@ -337,7 +337,8 @@ class TetComplex {
   std::size_t max_cavity = 4000;  ///< tets in a grown cavity, at most
   int deep_grow_limit = 64;  ///< cavity growth steps per deep candidate (relocate; 0: no deep candidates)
   std::size_t max_candidates = 1000;
-  /// Exact orientation tests made so far (the work measure of the phases' budgets).
+  /// Exact orientation tests made so far, plus the faces and tets a cavity growth handles (the
+  /// work measure of the budgets).
   std::int64_t work = 0;
   /// Removes v and the Steiner points `also` (any of them may be on the surface) and cones their
   /// cavity from one new double point w (header comment: RELOCATE). The surface faces that touch a
@@ -495,9 +496,16 @@ class TetComplex {
     const double mag = std::max({std::fabs(vr.x), std::fabs(vr.y), std::fabs(vr.z), lref});
     std::vector<Vec3> candidates;
     for (const double tau : {256 * 2.220446049250313e-16 * mag, 1e-9 * lref}) {
+      // The normals of the faces v nearly lies on, one per direction: the faces of a large
+      // re-triangulated surface polygon all share (up to rounding) their plane's normal, and the
+      // pairwise sums below would otherwise make O(k^2) directions scored against k normals.
       std::vector<Vec3> near;
       for (const auto& h : hs)
-        if (h.dist <= tau) near.push_back(h.m);
+        if (h.dist <= tau &&
+            std::none_of(near.begin(), near.end(), [&](const Vec3& m) {
+              return m.x * h.m.x + m.y * h.m.y + m.z * h.m.z > 1 - 1e-12;
+            }))
+          near.push_back(h.m);
       std::vector<Vec3> dirs{unit(dir)};
       Vec3 sum{0, 0, 0};
       for (const Vec3& m : near) {
@@ -671,6 +679,7 @@ class TetComplex {
         cav.insert(cav.end(), add.begin(), add.end());
         std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
         bs = cavity_bases(boundary);
+        work += static_cast<std::int64_t>(boundary.size() + cav.size());  // the growth's own cost
       }
       if (!ok) continue;
       for (Index id : cav) kill_tet(id);
@@ -880,6 +889,7 @@ class TetComplex {
       boundary = merge_boundaries(boundary, boundary_pairs(add));
       cav.insert(cav.end(), add.begin(), add.end());
       std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
+      work += static_cast<std::int64_t>(boundary.size() + cav.size());  // the growth's own cost
     }
     // Vertices that vanish (strictly inside the cavity) must be interior Steiner points.
     std::vector<Index> before, after;

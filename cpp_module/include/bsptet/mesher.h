@@ -39,7 +39,7 @@ struct MeshOptions {
   std::size_t bsp_candidate_shift = 0;
   /// SteinerRemovalOptions::interior_work_per_point: how hard the core tries to remove one interior
   /// Steiner point (exact orientation tests; 0 = no limit).
-  std::int64_t steiner_effort = 400000;
+  std::int64_t steiner_effort = 1000000;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;
   /// Called with (stage, fraction in [0, 1]); may be empty.
