@@ -191,6 +191,7 @@ TEST(ImplicitGeometry, Orient3dThroughACommonPlaneMatchesTheGeneralPath) {
     const Vec3 &p0 = pts[0], &p1 = pts[1], &p2 = pts[2];
     const double t = U(rng), e = 1e-13 * U(rng);
     pts.push_back({p0.x + t * (p2.x - p0.x) + e, p0.y + t * (p2.y - p0.y) - e, p0.z + t * (p2.z - p0.z)});
+    Sign first[4];  // pass 0's signs (a known common plane), per vertex order
     for (int pass = 0; pass < 2; ++pass) {
       ImplicitGeometry geo(pts);
       for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
@@ -203,15 +204,14 @@ TEST(ImplicitGeometry, Orient3dThroughACommonPlaneMatchesTheGeneralPath) {
       const Index pnear = it % 3 == 0 ? geo.add_plane(0, 1, 2) : geo.add_plane(0, 1, 19);
       const Index v1 = geo.add_tpi_vertex(pa, q[0], q[1]), v2 = geo.add_tpi_vertex(pb, q[1], q[2]),
                   v3 = geo.add_tpi_vertex(pc, q[2], q[3]), w = geo.add_tpi_vertex(pnear, q[3], q[4]);
-      static Sign first[4][4];
       const std::array<std::array<Index, 4>, 4> orders = {
           {{v1, v2, v3, w}, {v1, v2, w, v3}, {w, v1, v2, v3}, {v2, w, v3, v1}}};
       for (int o = 0; o < 4; ++o) {
         const Sign s = geo.orient3d(orders[o][0], orders[o][1], orders[o][2], orders[o][3]);
         if (pass == 0) {
-          first[0][o] = s;
+          first[o] = s;
         } else {
-          ASSERT_EQ(s, first[0][o]) << "iteration " << it << " order " << o << " seed " << seed;
+          ASSERT_EQ(s, first[o]) << "iteration " << it << " order " << o << " seed " << seed;
           zeros += s == Sign::kZero;
         }
       }
