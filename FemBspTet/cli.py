@@ -387,8 +387,9 @@ def build_parser():
                    help="keep Steiner points on the surface where they are exactly doubles "
                         "(default: none on the surface, as tetgen -Y)")
     m.add_argument("--steiner-effort", type=_non_negative_int, default=None, metavar="N",
-                   help="exact orientation tests the core may spend removing one interior Steiner "
-                        "point (default 1000000; 0: no bound, fewer Steiner points, possibly much slower)")
+                   help="work (exact orientation tests, cavity growth) the core may spend removing "
+                        "one interior Steiner point (default 1000000; 0: no bound, fewer Steiner "
+                        "points, possibly much slower)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.add_argument("--reorient", action="store_true",

@@ -154,8 +154,9 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is positive.
 
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``steiner_effort`` (int:
-    exact orientation tests the core may spend removing one interior Steiner point, default
-    1000000; 0 = no bound: fewer interior Steiner points, possibly minutes more), ``order`` (1 or 2),
+    work (exact orientation tests, cavity growth) the core may spend removing one interior Steiner
+    point, default 1000000; 0 = no bound: fewer interior Steiner points, possibly minutes more),
+    ``order`` (1 or 2),
     ``reorient`` (bool, default False: flip inconsistently oriented or inward-facing shells instead
     of refusing them, see :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before
     meshing, a run whose estimated peak memory exceeds it, :class:`MemoryBudgetError`; see

@@ -196,8 +196,8 @@ PYBIND11_MODULE(_bsptet, m) {
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
       "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison. "
-      "steiner_effort: exact orientation tests the core may spend removing one interior Steiner point "
-      "(0: no bound; MeshOptions::steiner_effort).");
+      "steiner_effort: work (exact orientation tests, cavity growth) the core may spend removing one "
+      "interior Steiner point (0: no bound; MeshOptions::steiner_effort).");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.

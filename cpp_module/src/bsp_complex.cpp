@@ -25,12 +25,12 @@ BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::v
 }
 
 Index BspComplex::new_face(BspFace f) {
-  f.has_box = !f.verts.empty();
+  f.box.ok = !f.verts.empty();
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (Index v : f.verts) {
     const std::array<Interval, 3>* b = geo_.vertex_box(v);
     if (!b) {
-      f.has_box = false;
+      f.box.ok = false;
       break;
     }
     for (int k = 0; k < 3; ++k) {
@@ -38,8 +38,8 @@ Index BspComplex::new_face(BspFace f) {
       hi[k] = std::max(hi[k], (*b)[k].hi());
     }
   }
-  if (f.has_box)
-    for (int k = 0; k < 3; ++k) f.box[k] = Interval(lo[k], hi[k]);
+  if (f.box.ok)
+    for (int k = 0; k < 3; ++k) f.box.box[k] = Interval(lo[k], hi[k]);
   faces_.push_back(std::move(f));
   const Index id = static_cast<Index>(faces_.size() - 1);
   register_edges(id);

@@ -1134,9 +1134,9 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     st.removed_by_phase[phase] += before - static_cast<std::int64_t>(steiner_vertices().size());
   };
   // The optional phases (merge .. retetrahedralize: interior Steiner points may stay) give each
-  // point at most options.interior_work_per_point exact orientation tests in all, so that a few
-  // points no local operation removes cannot cost minutes (a cube-sphere of 10^4 triangles spent
-  // 12 s in edge removals for 4 points). Counted in tests, not seconds: deterministic.
+  // point at most options.interior_work_per_point work units in all (TetComplex::work), so that a
+  // few points no local operation removes cannot cost minutes (a cube-sphere of 10^4 triangles
+  // spent 12 s in edge removals for 4 points). Counted in work, not seconds: deterministic.
   std::unordered_map<Index, std::int64_t> spent;
   auto affordable = [&](Index v) {
     return options.interior_work_per_point <= 0 || spent[v] < options.interior_work_per_point;

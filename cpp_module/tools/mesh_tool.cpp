@@ -6,8 +6,8 @@
 //
 // --bsp-shift K: score the BSP's sampled candidate planes shifted by K (another partition; what the
 //   core retries with, after --along-lines, when its Steiner removal gets stuck).
-// --steiner-effort N: exact orientation tests the core may spend on removing one interior Steiner
-//   point (0: no limit).
+// --steiner-effort N: work (exact orientation tests, cavity growth) the core may spend on removing
+//   one interior Steiner point (0: no limit).
 // --along-lines: refine the faces on input planes along whole input edge lines (the fallback
 //   tetrahedralize() uses by itself when the Steiner removal gets stuck).
 // --progress: print each stage and its percentage to stderr as it goes.

@@ -59,6 +59,14 @@ class VertexSigns {
   std::uint32_t stamp_ = 1;
 };
 
+/// Intervals enclosing a face's vertices; ok is false when a vertex had no interval box. Cells
+/// keep a copy beside their face ids, so that a split scans its cell's boxes in order instead of
+/// visiting every face record.
+struct FaceBox {
+  std::array<Interval, 3> box;
+  bool ok = false;
+};
+
 struct BspFace {
   Index plane = -1;
   std::vector<Index> verts;     ///< cyclic, CCW around the plane normal
@@ -67,16 +75,8 @@ struct BspFace {
   bool alive = true;
   /// Intervals enclosing every vertex (set by new_face; still valid when a vertex is inserted on an
   /// edge or replaced by one at the same place), so that a split can skip a face far from its
-  /// plane without deciding each vertex. has_box is false when a vertex had no interval box.
-  bool has_box = false;
-  std::array<Interval, 3> box;
-};
-
-/// A face's box as a cell keeps it (a copy of BspFace::box, next to the face ids, so that a split
-/// scans its cell's boxes in order instead of visiting every face record).
-struct FaceBox {
-  std::array<Interval, 3> box;
-  bool ok = false;
+  /// plane without deciding each vertex.
+  FaceBox box;
 };
 
 struct BspCell {
@@ -165,7 +165,7 @@ class BspComplex {
   /// the other id: the side with more faces keeps c, so fewer faces are relabelled), or -1 when p
   /// does not cut c's interior.
   Index split_cell(Index c, Index p);
-  FaceBox face_box(Index f) const { return {faces_[f].box, faces_[f].has_box}; }
+  const FaceBox& face_box(Index f) const { return faces_[f].box; }
   /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),
   /// inserting the new vertex into every face that uses the edge.
   void cut_crossing_edges(Index f, Index q, VertexSigns& sign);

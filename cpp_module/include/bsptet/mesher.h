@@ -38,7 +38,7 @@ struct MeshOptions {
   /// BspComplex::set_candidate_shift for the BSP's plane choice (0: the paper's sampling).
   std::size_t bsp_candidate_shift = 0;
   /// SteinerRemovalOptions::interior_work_per_point: how hard the core tries to remove one interior
-  /// Steiner point (exact orientation tests; 0 = no limit).
+  /// Steiner point (work: exact orientation tests and cavity growth; 0 = no limit).
   std::int64_t steiner_effort = 1000000;
   /// Check the cell complex's combinatorics after every split (slow; for tests and debugging).
   bool debug_checks = false;

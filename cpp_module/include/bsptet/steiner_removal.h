@@ -108,8 +108,9 @@ namespace bsptet {
 struct SteinerRemovalOptions {
   bool allow_boundary_steiner = false;
   /// The effort the optional phases (merge, cone_neighbours, edge_removal, cone_nearest,
-  /// retetrahedralize) may spend on one interior Steiner point, in exact orientation tests; a
-  /// point still there when its budget is spent stays (interior Steiner points are valid).
+  /// retetrahedralize) may spend on one interior Steiner point, in work units (exact orientation
+  /// tests, and the faces and tets a cavity growth handles); a point still there when its budget is
+  /// spent stays (interior Steiner points are valid).
   /// 0: unlimited.
   std::int64_t interior_work_per_point = 0;
   std::function<bool()> cancelled;          ///< polled now and then; true stops (MeshingError kCancelled)
