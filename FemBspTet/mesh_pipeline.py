@@ -63,6 +63,7 @@ PROPERTY_OF = {
     "allow_boundary_steiner": "AllowBoundarySteiner",
     "face_groups": "FaceGroups",
     "compare_tetgen": "CompareWithTetGen",
+    "remesh_surface": "RemeshSurface",
 }
 
 #: Prefix of the FemMesh node group made for each CAD face (``BspTet_Face3``). FEM's CalculiX
@@ -82,9 +83,10 @@ _OUTWARD_FACES = ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2))
 class MeshParameters:
     """What the mesher object's properties ask for. Lengths in mm, angles in radians.
 
-    max_size:               maximum element size h (CharacteristicLengthMax); 0 = automatic.
-                            Sets the tessellation's default deflection; volume size control
-                            needs the quality stage of the core.
+    max_size:               maximum element size h (CharacteristicLengthMax); 0 = automatic:
+                            with remesh_surface, h = the bounding-box diagonal / 20 (surface
+                            and volume); without it, the tessellation is filled as it is.
+                            Also sets the tessellation's default deflection.
     min_size:               minimum element size (CharacteristicLengthMin); 0 = none. Needs the
                             quality stage (refused with a message otherwise).
     order:                  1 (tet4) or 2 (tet10).
@@ -96,6 +98,9 @@ class MeshParameters:
     allow_boundary_steiner: keep Steiner points on the surface (they are projected onto the CAD).
     face_groups:            one FemMesh node group per CAD face (``BspTet_Face<k>``).
     compare_tetgen:         also run ``tetgen -pY`` on the same surface and report its counts.
+    remesh_surface:         remesh the tessellation of each CAD face towards the element size
+                            (:mod:`FemBspTet.surface_remesh`) before the volume mesh; off: the
+                            core fills OpenCASCADE's tessellation as it is.
     """
 
     max_size: float = 0.0
@@ -107,6 +112,7 @@ class MeshParameters:
     allow_boundary_steiner: bool = False
     face_groups: bool = False
     compare_tetgen: bool = False
+    remesh_surface: bool = True
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -297,27 +303,50 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     check_cancel()
     projection = CadProjection(shape)
     options = core_options(params, projection)
+    element_size = params.max_size if params.max_size > 0 else automatic_element_size(shape)
+    if params.remesh_surface:
+        # the surface gets the element size: the volume follows it (without this, the core
+        # would fill a fine surface with long tets reaching across the solid)
+        options[CORE_OPTION_OF["max_size"]] = float(element_size)
+    tessellation = surfaces
+    size_points = np.zeros((0, 4))
+    rounds = LOCAL_REFINEMENT_ROUNDS if params.remesh_surface and params.order == 2 else 0
 
     def core_progress(stage, fraction):
         report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
 
-    try:
-        mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
-                                          cancel=cancel)
-    except BspTetError:
-        check_cancel()  # the core stopped because cancel() said so (whatever error it raised)
-        raise
-    check_cancel()
+    for attempt in range(rounds + 1):
+        remesh_notes, remesh_stats = [], {}
+        if params.remesh_surface:
+            report("remeshing the CAD faces" if attempt == 0 else
+                   "remeshing the CAD faces finer where curved tet10s inverted (round %d)"
+                   % attempt, 0.02)
+            surfaces, remesh_notes, remesh_stats = remesh_cad_surfaces(
+                tessellation, projection, element_size, params, deflection, cancel=check_cancel,
+                size_points=size_points)
+        try:
+            mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
+                                              cancel=cancel)
+        except BspTetError:
+            check_cancel()  # the core stopped because cancel() said so (whatever it raised)
+            raise
+        check_cancel()
 
-    report("placing boundary nodes on the CAD faces", 0.87)
-    faces, tags = boundary_faces_with_tags(mesh, surfaces)
-    midnodes = boundary_midnodes(mesh, faces) if mesh.tets.shape[1] == 10 else \
-        np.zeros((0, 3), dtype=np.int64)
-    input_points = np.concatenate([s.points for s in surfaces])
-    moved, max_move = place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points,
-                                                  projection, cancel=check_cancel)
+        report("placing boundary nodes on the CAD faces", 0.87)
+        faces, tags = boundary_faces_with_tags(mesh, surfaces)
+        midnodes = boundary_midnodes(mesh, faces) if mesh.tets.shape[1] == 10 else \
+            np.zeros((0, 3), dtype=np.int64)
+        input_points = np.concatenate([s.points for s in surfaces])
+        moved, max_move = place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points,
+                                                      projection, cancel=check_cancel)
+        bad = elements_inverted_by_projection(mesh, moved)
+        if len(bad) == 0 or attempt == rounds:
+            break
+        size_points = np.vstack([size_points, refinement_points(mesh, bad, params.min_size)])
     check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
                                     stats.get("min_dihedral_deg"))
+    if attempt:
+        remesh_stats["local_refinement_rounds"] = attempt
     check_cancel()
 
     report("looking for interior nodes within the CAD face tolerance", 0.9)
@@ -329,7 +358,9 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     stats["projected_nodes"] = int(len(moved))
     stats["max_projection_mm"] = float(max_move)
     stats["linear_deflection"] = float(deflection)
-    notes = list(stats.get("notes", []))
+    if remesh_stats:
+        stats["surface_remesh"] = remesh_stats
+    notes = remesh_notes + list(stats.get("notes", []))
     if near:
         notes.append(
             "%d interior node(s) lie within the CAD face tolerance of a face (%s): FreeCAD's "
@@ -346,6 +377,56 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     mesh.source = source or mesh.source
     return MeshResult(mesh, faces, tags, midnodes, shape_face_names(projection), stats, tetgen,
                       notes)
+
+
+#: CharacteristicLengthMax 0 (automatic) with RemeshSurface: h = bounding-box diagonal / this.
+AUTOMATIC_SIZE_OF_DIAGONAL = 20.0
+
+
+def automatic_element_size(shape):
+    """The element size of CharacteristicLengthMax 0: the shape's bounding-box diagonal / 20."""
+    from . import cad_tessellation
+
+    return cad_tessellation._diagonal(shape) / AUTOMATIC_SIZE_OF_DIAGONAL
+
+
+def remesh_cad_surfaces(surfaces, projection, size, params, deflection, cancel=None,
+                        size_points=None):
+    """Each solid's tessellation remeshed by :func:`FemBspTet.surface_remesh.remesh_surface`
+    towards the element size ``size``, with the tessellation's deflections as the curvature
+    bounds. Faces that two solids share are left as they are (both
+    sides must stay identical). A remeshed surface the core's exact input check refuses (a
+    self-intersection the remeshing made, say) is replaced by the tessellation itself, with a
+    note. Returns ``(surfaces, notes, stats)``: stats summed over the solids."""
+    from . import core
+    from .errors import InputError
+    from .surface_remesh import RemeshError, remesh_surface
+
+    counts = {}
+    for surf in surfaces:
+        for tag in set(surf.face_tags.tolist()):
+            counts[tag] = counts.get(tag, 0) + 1
+    frozen = {tag for tag, c in counts.items() if c > 1}
+    out, notes, total = [], [], {}
+    for i, surf in enumerate(surfaces):
+        where = "solid %d" % (i + 1) if len(surfaces) > 1 else "the solid"
+        try:
+            new, st = remesh_surface(surf, projection, size, deflection, params.angular_deflection,
+                                     min_size=params.min_size, frozen_tags=frozen, cancel=cancel,
+                                     size_points=size_points)
+            core.check_surface(new)
+        except (RemeshError, InputError) as e:
+            notes.append("the surface remeshing of %s was not used (%s): the volume mesh is made "
+                         "on OpenCASCADE's tessellation" % (where, e))
+            out.append(surf)
+            continue
+        for k, v in st.items():
+            if k.startswith(("min_", "median_")):
+                total[k] = min(total.get(k, v), v)
+            else:
+                total[k] = total.get(k, 0) + v
+        out.append(new)
+    return out, notes, total
 
 
 def shape_face_names(projection):
@@ -547,6 +628,40 @@ def tet10_jacobians(points, tets):
         j1, j2, j3 = grads[1] - grads[0], grads[2] - grads[0], grads[3] - grads[0]
         out[:, s] = np.einsum("ij,ij->i", np.cross(j1, j2), j3)
     return out
+
+
+#: With RemeshSurface and tet10: how many times the surface is remeshed finer around tets that
+#: the curved mid-nodes would invert before the pipeline gives up with the error.
+LOCAL_REFINEMENT_ROUNDS = 3
+
+
+def elements_inverted_by_projection(mesh, moved):
+    """Indices of the tets with a moved node that are inverted or (tet10) have a non-positive
+    Jacobian determinant at a node or the centroid (double precision)."""
+    if len(moved) == 0:
+        return np.zeros(0, dtype=np.int64)
+    is_moved = np.zeros(len(mesh.points), dtype=bool)
+    is_moved[moved] = True
+    touched = np.nonzero(is_moved[mesh.tets].any(axis=1))[0]
+    t = mesh.tets[touched]
+    p = mesh.points
+    a, b, c, d = (p[t[:, i]] for i in range(4))
+    bad = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) <= 0
+    if t.shape[1] == 10:
+        bad |= (tet10_jacobians(p, t) <= 0).any(axis=1)
+    return touched[bad]
+
+
+def refinement_points(mesh, tets, min_size=0.0):
+    """Size points ``x, y, z, s`` (for ``surface_remesh.remesh_surface``) that make the surface
+    around ``tets`` half as fine as their longest edge (never below ``min_size``)."""
+    corners = mesh.points[mesh.tets[tets, :4]]  # (k, 4, 3)
+    longest = np.zeros(len(tets))
+    for i in range(4):
+        for j in range(i + 1, 4):
+            longest = np.maximum(longest, np.linalg.norm(corners[:, i] - corners[:, j], axis=1))
+    size = np.maximum(0.5 * longest, min_size)
+    return np.column_stack([corners.mean(axis=1), size])
 
 
 def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_dihedral=None):

@@ -31,8 +31,8 @@ RESULTS_GROUP = "BspTet Mesh Results"
 PARAMETER_PROPERTIES = (
     ("App::PropertyLink", "Part", "FEM Mesh", "The solid (Part) the mesh is made from", None),
     ("App::PropertyLength", "CharacteristicLengthMax", PARAMS_GROUP,
-     "Maximum element size (0 = automatic). Sets the surface tessellation; volume size control "
-     "needs the core's quality stage", 0.0),
+     "Maximum element size (0 = automatic: the bounding-box diagonal / 20 when RemeshSurface "
+     "is on; without it the tessellation is filled as it is)", 0.0),
     ("App::PropertyLength", "CharacteristicLengthMin", PARAMS_GROUP,
      "Minimum element size (0 = none). Needs the core's quality stage", 0.0),
     ("App::PropertyEnumeration", "ElementOrder", PARAMS_GROUP,
@@ -52,6 +52,9 @@ PARAMETER_PROPERTIES = (
      "Make a node group per CAD face (BspTet_Face1, ...)", False),
     ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
      "Also run tetgen -pY on the same surface and show its counts", True),
+    ("App::PropertyBool", "RemeshSurface", PARAMS_GROUP,
+     "Remesh each CAD face's tessellation towards the element size (well-shaped triangles on "
+     "the CAD faces, as Gmsh and Netgen do) before the volume mesh", True),
 )
 
 #: (type, name, tooltip) of every read-only result property.

@@ -67,7 +67,8 @@ class TaskPanelMeshBspTet:
         self.ck_boundary = QtGui.QCheckBox("Allow Steiner points on the surface")
         self.ck_groups = QtGui.QCheckBox("Node group per CAD face")
         self.ck_tetgen = QtGui.QCheckBox("Compare with tetgen -pY")
-        for ck in (self.ck_boundary, self.ck_groups, self.ck_tetgen):
+        self.ck_remesh = QtGui.QCheckBox("Remesh the CAD faces to the element size")
+        for ck in (self.ck_boundary, self.ck_groups, self.ck_tetgen, self.ck_remesh):
             grid.addRow(ck)
         layout.addWidget(params)
 
@@ -131,6 +132,7 @@ class TaskPanelMeshBspTet:
         self.ck_boundary.setChecked(bool(o.AllowBoundarySteiner))
         self.ck_groups.setChecked(bool(o.FaceGroups))
         self.ck_tetgen.setChecked(bool(o.CompareWithTetGen))
+        self.ck_remesh.setChecked(bool(getattr(o, "RemeshSurface", True)))
 
     def store_parameters(self):
         o = self.obj
@@ -143,6 +145,8 @@ class TaskPanelMeshBspTet:
         o.AllowBoundarySteiner = self.ck_boundary.isChecked()
         o.FaceGroups = self.ck_groups.isChecked()
         o.CompareWithTetGen = self.ck_tetgen.isChecked()
+        if hasattr(o, "RemeshSurface"):
+            o.RemeshSurface = self.ck_remesh.isChecked()
 
     # ---------------------------------------------------------------- task dialog API
 

@@ -1,0 +1,177 @@
+"""The surface remesher (FemBspTet.surface_remesh) on real CAD faces: the remeshed surface is
+closed and outward, keeps every triangle's CAD face, every vertex lies on its CAD face (and on
+the CAD edge when it is between two faces) within the face's tolerance, the enclosed volume
+stays the solid's, the triangles get well shaped, faces shared by two solids are kept, and the
+pipeline falls back to the tessellation when the core refuses a remeshed surface.
+
+The shapes are placed off the origin and rotated so that no face is along the axes by accident.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from FemBspTet.freecad_env import freecad_available
+
+if not freecad_available():
+    pytest.skip("FreeCAD (Debian package freecad-python3) is not available",
+                allow_module_level=True)
+
+from FemBspTet import cad_tessellation, core, mesh_pipeline  # noqa: E402
+from FemBspTet.surface_remesh import remesh_surface, triangle_quality_stats  # noqa: E402
+
+
+def placed(fc, shape, rotate=True):
+    freecad, _, _ = fc
+    shape = shape.copy()
+    rot = freecad.Rotation(freecad.Vector(1, 2, 3), 37.0) if rotate else freecad.Rotation()
+    shape.Placement = freecad.Placement(freecad.Vector(103.5, -7.25, 11.0), rot)
+    return shape
+
+
+def shaft_with_fillet(fc):
+    freecad, Part, _ = fc
+    body = Part.makeCylinder(10, 60).fuse(Part.makeCylinder(16, 12, freecad.Vector(0, 0, 60)))
+    body = body.removeSplitter()
+    edge = [e for e in body.Edges if type(e.Curve).__name__ == "Circle"
+            and abs(e.Curve.Radius - 10) < 1e-9 and abs(e.BoundBox.ZMin - 60) < 1e-9]
+    return body.makeFillet(3.0, edge)
+
+
+def remeshed(fc, shape, size, deflection=None):
+    from FemBspTet.cad_projection import CadProjection
+
+    deflection = deflection or cad_tessellation.default_linear_deflection(shape, size)
+    surf = cad_tessellation.tessellate_shape(shape, deflection)[0]
+    proj = CadProjection(shape)
+    out, stats = remesh_surface(surf, proj, size, deflection, 0.5)
+    return surf, out, stats, proj
+
+
+def vertex_tags(surface):
+    tags = {}
+    for tri, tag in zip(surface.triangles.tolist(), surface.face_tags.tolist()):
+        for v in tri:
+            tags.setdefault(v, set()).add(tag)
+    return tags
+
+
+@pytest.mark.parametrize("rotate", [False, True])
+def test_remeshed_shaft_is_closed_on_the_cad_and_well_shaped(fc, rotate):
+    shape = placed(fc, shaft_with_fillet(fc), rotate)
+    surf, out, stats, proj = remeshed(fc, shape, size=4.0)
+    print("remesh stats:", stats)
+    cad_tessellation.check_closed(out, "remeshed")
+    core.check_surface(out)  # exact: closed, oriented, no self-intersection
+    # the same CAD faces, every one still meshed
+    assert set(out.face_tags.tolist()) == set(surf.face_tags.tolist())
+    # the enclosed volume is the solid's within what chords sagging by the deflection lose
+    vol = cad_tessellation.signed_volume(out.points, out.triangles)
+    vol0 = cad_tessellation.signed_volume(surf.points, surf.triangles)
+    defl = cad_tessellation.default_linear_deflection(shape, 4.0)
+    print("volume: solid %.6g, tessellation %.6g, remeshed %.6g" % (shape.Volume, vol0, vol))
+    assert 0 < shape.Volume - vol < defl * shape.Area
+    # every vertex on its CAD face(s) within the face tolerance, edge vertices on both faces
+    tags = vertex_tags(out)
+    rng = np.random.default_rng(7)
+    sample = rng.choice(len(out.points), size=min(400, len(out.points)), replace=False)
+    for v in sample.tolist():
+        for t in tags[v]:
+            d = proj.distance_to_face(out.points[v], t)
+            assert d <= max(proj.face_tolerance(t), 1e-7), (v, t, d)
+    # needles gone: BRepMesh's cylinder strips have median quality far below 0.5
+    assert stats["median_quality_before"] < 0.5
+    assert stats["median_quality_after"] > 0.85
+    assert stats["min_angle_deg_after"] > stats["min_angle_deg_before"]
+    # edge lengths near the size: none longer than 4/3 of it by much
+    e = out.points[out.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)]
+    lengths = np.linalg.norm(e[:, 0] - e[:, 1], axis=1)
+    assert lengths.max() <= 4.0 / 3.0 * 4.0 * 1.01
+
+
+def test_axis_planes_stay_exactly_planar(fc):
+    """Projected points on a plane x = c of the tessellation are put exactly on x = c: four
+    points of one planar face an ulp apart would make the core fill the gap with a flat tet."""
+    _, Part, _ = fc
+    shape = placed(fc, Part.makeBox(30, 20, 10).cut(
+        Part.makeCylinder(4, 10, fc[0].Vector(15, 10, 0))), rotate=False)
+    surf, out, _, _ = remeshed(fc, shape, size=2.0)
+    for k, face in enumerate(shape.Faces):
+        if type(face.Surface).__name__ != "Plane":
+            continue
+        pts = out.points[np.unique(out.triangles[out.face_tags == k])]
+        assert any(len(np.unique(pts[:, i])) == 1 for i in range(3)), "Face%d" % (k + 1)
+
+
+def test_tet10_on_remeshed_plate_with_hole_is_valid_and_on_the_cad(fc):
+    """tet10 next to a curved hole: with the remeshed surface the curved mid-nodes invert
+    nothing (the pipeline's own exact check), every boundary node is on its face."""
+    freecad, Part, _ = fc
+    shape = placed(fc, Part.makeBox(60, 40, 8).cut(
+        Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0))))
+    params = mesh_pipeline.MeshParameters(max_size=6.0, order=2, compare_tetgen=False)
+    result = mesh_pipeline.mesh_cad_shape(shape, params)
+    st = result.stats["surface_remesh"]
+    print("remesh:", st, "min dihedral", result.stats["min_dihedral_deg"])
+    assert st["triangles_after"] > 0 and not result.notes
+    assert result.mesh.tets.shape[1] == 10
+    jac = mesh_pipeline.tet10_jacobians(result.mesh.points, result.mesh.tets)
+    assert (jac > 0).all()
+    assert result.stats["min_dihedral_deg"] > 5.0
+
+
+def test_faces_shared_by_two_solids_are_left_as_they_are(fc):
+    freecad, Part, _ = fc
+    a = Part.makeBox(10, 10, 10)
+    b = Part.makeBox(10, 10, 10, freecad.Vector(10, 0, 0))
+    shape = Part.CompSolid([a, b]) if hasattr(Part, "CompSolid") else None
+    if shape is None:
+        pytest.skip("no Part.CompSolid")
+    shape = a.generalFuse([b])[0]
+    shape = Part.CompSolid(shape.Solids)
+    from FemBspTet.cad_projection import CadProjection
+
+    defl = cad_tessellation.default_linear_deflection(shape, 3.0)
+    surfaces = cad_tessellation.tessellate_shape(shape, defl)
+    shared = set(surfaces[0].face_tags.tolist()) & set(surfaces[1].face_tags.tolist())
+    assert shared, "the two boxes share a face"
+    params = mesh_pipeline.MeshParameters(max_size=3.0, order=1)
+    out, notes, _ = mesh_pipeline.remesh_cad_surfaces(surfaces, CadProjection(shape), 3.0,
+                                                      params, defl)
+    assert not notes
+    for tag in shared:
+        for before, after in zip(surfaces, out):
+            t0 = before.triangles[before.face_tags == tag]
+            t1 = after.triangles[after.face_tags == tag]
+            assert sorted(map(tuple, np.sort(before.points[t0].reshape(-1, 3), axis=0))) == \
+                sorted(map(tuple, np.sort(after.points[t1].reshape(-1, 3), axis=0)))
+    # the faces that are not shared were remeshed
+    assert sum(len(s.triangles) for s in out) > sum(len(s.triangles) for s in surfaces)
+
+
+def test_a_remeshed_surface_the_core_refuses_falls_back_to_the_tessellation(fc, monkeypatch):
+    """If the remesher returned a surface the exact input check refuses, the mesh is made on
+    the tessellation and a note says so."""
+    _, Part, _ = fc
+    import FemBspTet.surface_remesh as sr
+
+    def broken(surface, *args, **kwargs):
+        bad = cad_tessellation.Surface(surface.points, surface.triangles[1:],
+                                       surface.face_tags[1:], surface.face_names,
+                                       surface.source)  # one triangle missing: open
+        return bad, {"triangles_before": len(surface.triangles)}
+
+    monkeypatch.setattr(sr, "remesh_surface", broken)
+    params = mesh_pipeline.MeshParameters(max_size=4.0, order=1, compare_tetgen=False)
+    result = mesh_pipeline.mesh_cad_shape(placed(fc, Part.makeBox(10, 12, 14)), params)
+    assert any("remeshing" in n and "not used" in n for n in result.notes), result.notes
+    assert len(result.mesh.tets) > 0
+
+
+def test_quality_stats_of_an_equilateral_and_a_needle():
+    pts = np.array([[0, 0, 0], [1, 0, 0], [0.5, math.sqrt(3) / 2, 0], [100, 0.001, 0]])
+    qmin, qmed, amin = triangle_quality_stats(pts, np.array([[0, 1, 2]]))
+    assert abs(qmin - 1) < 1e-12 and abs(amin - 60) < 1e-9
+    qmin, _, amin = triangle_quality_stats(pts, np.array([[0, 1, 3]]))
+    assert qmin < 1e-3 and amin < 0.01
