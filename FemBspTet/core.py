@@ -323,6 +323,9 @@ REFINE_OPTIONS = {
     "size": "target edge length h (model units; edges longer than 2 h are split, as FreeCAD's CharacteristicLengthMax for Gmsh)",
     "min_size": "edges shorter than 2 min_size are never split (default: smallest size / 8)",
     "size_by_tag": "{face tag: size} near the input triangles of that tag (a CAD face)",
+    "size_from_surface": "True: the size at each input triangle is at most its mean edge length "
+                         "(the volume grades from a surface already meshed to size, as Gmsh's "
+                         "MeshSizeExtendFromBoundary)",
     "radius_edge": "refine tets whose circumradius / shortest edge exceeds this (0 or None: off)",
     "min_dihedral": "the optimization stops once the smallest dihedral angle reaches this (deg)",
     "surface_points": "'exact' (default): new surface points exactly on the input facets, else "
@@ -399,7 +402,8 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
             min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
             projection=projection, max_passes=0 if only_order else 40, optimize_rounds=8,
-            separate_face_tags=bool(options.get("separate_face_tags")), progress=progress,
+            separate_face_tags=bool(options.get("separate_face_tags")),
+            size_from_surface=bool(options.get("size_from_surface")), progress=progress,
             cancel=cancel)
     out = TetMesh(points, tets, mesh.source)
     exact = mode == "exact" and projection is None

@@ -99,8 +99,9 @@ class MeshParameters:
     face_groups:            one FemMesh node group per CAD face (``BspTet_Face<k>``).
     compare_tetgen:         also run ``tetgen -pY`` on the same surface and report its counts.
     remesh_surface:         remesh the tessellation of each CAD face towards the element size
-                            (:mod:`FemBspTet.surface_remesh`) before the volume mesh; off: the
-                            core fills OpenCASCADE's tessellation as it is.
+                            (:mod:`FemBspTet.surface_remesh`) before the volume mesh, and make
+                            the volume to that size; off (default): the core fills
+                            OpenCASCADE's tessellation as it is (README: what it gains, costs).
     """
 
     max_size: float = 0.0
@@ -112,7 +113,7 @@ class MeshParameters:
     allow_boundary_steiner: bool = False
     face_groups: bool = False
     compare_tetgen: bool = False
-    remesh_surface: bool = True
+    remesh_surface: bool = False
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -315,6 +316,7 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     def core_progress(stage, fraction):
         report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
 
+    best = None
     for attempt in range(rounds + 1):
         remesh_notes, remesh_stats = [], {}
         if params.remesh_surface:
@@ -337,12 +339,19 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         midnodes = boundary_midnodes(mesh, faces) if mesh.tets.shape[1] == 10 else \
             np.zeros((0, 3), dtype=np.int64)
         input_points = np.concatenate([s.points for s in surfaces])
-        moved, max_move = place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points,
-                                                      projection, cancel=check_cancel)
+        moved, max_move, kept = place_boundary_nodes_on_cad(
+            mesh, faces, tags, midnodes, input_points, projection, cancel=check_cancel)
         bad = elements_inverted_by_projection(mesh, moved)
+        if best is None or len(bad) < best[0]:
+            best = (len(bad), attempt, (surfaces, remesh_notes, remesh_stats, mesh, stats, faces,
+                                        tags, midnodes, moved, max_move, kept))
+        elif len(bad) >= best[0]:
+            break  # refining made it no better: keep the best attempt
         if len(bad) == 0 or attempt == rounds:
             break
         size_points = np.vstack([size_points, refinement_points(mesh, bad, params.min_size)])
+    _, attempt, (surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes, moved,
+                 max_move, kept) = best
     check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
                                     stats.get("min_dihedral_deg"))
     if attempt:
@@ -361,6 +370,13 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     if remesh_stats:
         stats["surface_remesh"] = remesh_stats
     notes = remesh_notes + list(stats.get("notes", []))
+    if kept:
+        worst = max(d for _, d in kept.values())
+        faces_named = sorted({"Face%d" % (t + 1) for ts, _ in kept.values() for t in ts})
+        notes.append(
+            "%d boundary node(s) stay off the CAD (up to %.3g mm, at %s): their place on the CAD "
+            "edge is another node's (the mesh edge there is not along the CAD edge of its two "
+            "faces), so getNodesByFace may miss them" % (len(kept), worst, ", ".join(faces_named)))
     if near:
         notes.append(
             "%d interior node(s) lie within the CAD face tolerance of a face (%s): FreeCAD's "
@@ -558,8 +574,11 @@ def place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points, proje
 
     A node's CAD faces are the tags of the boundary triangles it belongs to (for a mid-node:
     the triangles sharing its edge); one face: projected onto it; two: onto their common CAD
-    edge (:meth:`CadProjection.to_faces`). Modifies ``mesh.points`` in place. Returns
-    ``(moved node indices, largest displacement in mm)``.
+    edge (:meth:`CadProjection.to_faces`). Modifies ``mesh.points`` in place. A node whose
+    projection lands exactly on another node (OpenCASCADE clamps to a CAD vertex when the mesh
+    edge is not along the CAD edge its two faces share) is left where it is: two nodes at one
+    place would make the mesh non-conforming. Returns ``(moved node indices, largest
+    displacement in mm, {node: (tags, distance to its CAD place in mm)} of the nodes left)``.
     """
     pts = mesh.points
     node_tags = {}
@@ -571,17 +590,22 @@ def place_boundary_nodes_on_cad(mesh, faces, tags, midnodes, input_points, proje
         if len(midnodes):
             for m in midnodes[k].tolist():
                 node_tags.setdefault(m, set()).add(t)
-    moved, max_move = [], 0.0
+    moved, max_move, kept = [], 0.0, {}
+    taken = {tuple(p) for p in pts.tolist()}
     for i, (n, ts) in enumerate(sorted(node_tags.items())):
         if cancel is not None and i % 256 == 0:
             cancel()
         q = np.array(projection.to_faces(pts[n], ts), dtype=np.float64)
         d = float(np.linalg.norm(q - pts[n]))
         if d > 0:
+            if tuple(q.tolist()) in taken:
+                kept[n] = (sorted(ts), d)
+                continue
             pts[n] = q
+            taken.add(tuple(q.tolist()))
             moved.append(n)
             max_move = max(max_move, d)
-    return np.array(moved, dtype=np.int64), max_move
+    return np.array(moved, dtype=np.int64), max_move, kept
 
 
 def interior_nodes_near_faces(mesh, faces, midnodes, projection):

@@ -54,7 +54,8 @@ PARAMETER_PROPERTIES = (
      "Also run tetgen -pY on the same surface and show its counts", True),
     ("App::PropertyBool", "RemeshSurface", PARAMS_GROUP,
      "Remesh each CAD face's tessellation towards the element size (well-shaped triangles on "
-     "the CAD faces, as Gmsh and Netgen do) before the volume mesh", True),
+     "the CAD faces, as Gmsh and Netgen do) before the volume mesh. Better shaped tets, "
+     "slower, more tets", False),
 )
 
 #: (type, name, tooltip) of every read-only result property.

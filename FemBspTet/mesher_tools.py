@@ -31,7 +31,7 @@ def parameters_from_object(obj):
         allow_boundary_steiner=bool(obj.AllowBoundarySteiner),
         face_groups=bool(obj.FaceGroups),
         compare_tetgen=bool(obj.CompareWithTetGen),
-        remesh_surface=bool(getattr(obj, "RemeshSurface", True)),
+        remesh_surface=bool(getattr(obj, "RemeshSurface", False)),
     ).validate()
 
 

@@ -31,7 +31,7 @@ def object_defaults():
         "CompareWithTetGen": g.GetBool("CompareWithTetGen", True),
         "FaceGroups": g.GetBool("FaceGroups", False),
         "AllowBoundarySteiner": g.GetBool("AllowBoundarySteiner", False),
-        "RemeshSurface": g.GetBool("RemeshSurface", True),
+        "RemeshSurface": g.GetBool("RemeshSurface", False),
     }
 
 

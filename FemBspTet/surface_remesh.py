@@ -155,14 +155,17 @@ def remesh_surface(surface, projection, size, linear_deflection, angular_deflect
         r.split_long_edges()
         r.collapse_short_edges()
         r.flip_edges()
+        r.fix_ears()
         r.smooth()
     r.flip_edges()
+    r.fix_ears()
     out = r.surface()
     after = triangle_quality_stats(out.points, out.triangles)
     stats = {
         "triangles_before": int(len(surface.triangles)), "triangles_after": int(len(out.triangles)),
         "splits": r.count["split"], "collapses": r.count["collapse"], "flips": r.count["flip"],
         "moves": r.count["move"], "refused": r.count["refused"],
+        "ears_removed": r.count.get("ears", 0),
         "min_quality_before": before[0], "median_quality_before": before[1],
         "min_angle_deg_before": before[2],
         "min_quality_after": after[0], "median_quality_after": after[1],
@@ -370,6 +373,40 @@ class _Remesher:
             return False
         ref = self.ref_normal(tri, tag)
         return _dot(n, ref) >= self.cos_fold * ln
+
+    def is_ear(self, tri, tag):
+        """True if all three vertices of triangle ``tri`` (of face ``tag``) lie on one CAD edge
+        of that face: a sliver as thin as the edge's sag, under which any tet is flat."""
+        common = None
+        for v in tri:
+            if self.kind[v] == _FACE:
+                return False
+            common = set(self.vtags[v]) if common is None else common & set(self.vtags[v])
+        common.discard(tag)
+        if not common:
+            return False
+        # three vertices on one CAD edge have two feature edges among their three edges
+        feature = sum(1 for i in range(3) if self.is_feature(tri[i], tri[(i + 1) % 3]))
+        return feature >= 2
+
+    def fix_ears(self):
+        """Remove ears (:meth:`is_ear`): flip their inner edge, or split it (the new vertex
+        goes onto the face, inside)."""
+        self.check_cancel()
+        for t in range(len(self.T)):
+            tri = self.T[t]
+            if tri is None or self.tag[t] in self.frozen or not self.is_ear(tri, self.tag[t]):
+                continue
+            for i in range(3):
+                a, b = tri[i], tri[(i + 1) % 3]
+                if self.is_feature(a, b):
+                    continue
+                ts = sorted(self.edge_tris(a, b))
+                if len(ts) != 2:
+                    continue
+                if self.flip(a, b, ts, ear=True) or self.split(a, b, ts):
+                    self.count["ears"] = self.count.get("ears", 0) + 1
+                break
 
     def tri_normal(self, tri, pos=None):
         P = self.P
@@ -602,7 +639,7 @@ class _Remesher:
             if t in shared:
                 continue
             new = [b if v == a else v for v in self.T[t]]
-            if not self.tri_ok(new, self.tag[t]):
+            if not self.tri_ok(new, self.tag[t]) or self.is_ear(new, self.tag[t]):
                 return False
             old_n = self.tri_normal(self.T[t])
             if _dot(self.tri_normal(new), old_n) < self.cos_fold:
@@ -629,7 +666,9 @@ class _Remesher:
                 continue
             self.flip(a, b, ts)
 
-    def flip(self, a, b, ts):
+    def flip(self, a, b, ts, ear=False):
+        """Flip edge (a, b) if that improves the worse triangle's quality (``ear``: if it
+        removes an ear, whatever the quality) and makes no fold, crease or ear."""
         tag = self.tag[ts[0]]
         if tag in self.frozen:
             return False
@@ -641,12 +680,14 @@ class _Remesher:
             return False
         if len(self.neighbours(a)) <= 3 or len(self.neighbours(b)) <= 3:
             return False
-        if _dist(self.P[c], self.P[d]) > 4.0 / 3.0 * self.target(c, d):
+        if not ear and _dist(self.P[c], self.P[d]) > 4.0 / 3.0 * self.target(c, d):
             return False
         t1, t2 = (x, d, c), (d, y, c)
+        if self.is_ear(t1, tag) or self.is_ear(t2, tag):
+            return False
         q_old = min(self.tri_quality(self.T[ts[0]]), self.tri_quality(self.T[ts[1]]))
         q_new = min(self.tri_quality(t1), self.tri_quality(t2))
-        if not q_new > q_old + 1e-6:
+        if not ear and not q_new > q_old + 1e-6:
             return False
         if not (self.tri_ok(t1, tag) and self.tri_ok(t2, tag)):
             return False

@@ -132,7 +132,7 @@ class TaskPanelMeshBspTet:
         self.ck_boundary.setChecked(bool(o.AllowBoundarySteiner))
         self.ck_groups.setChecked(bool(o.FaceGroups))
         self.ck_tetgen.setChecked(bool(o.CompareWithTetGen))
-        self.ck_remesh.setChecked(bool(getattr(o, "RemeshSurface", True)))
+        self.ck_remesh.setChecked(bool(getattr(o, "RemeshSurface", False)))
 
     def store_parameters(self):
         o = self.obj

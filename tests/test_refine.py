@@ -243,6 +243,24 @@ def test_size_by_tag_refines_near_one_face():
     assert len(fine.tets) > len(coarse.tets)
 
 
+def test_size_from_surface_grades_the_volume_from_small_surface_triangles():
+    """size_from_surface: an icosphere of radius 1 with edges about 0.16 meshed at size 2: the
+    tets near the surface get about the surface's edge length instead of the size (the core alone
+    fills the ball with long tets reaching across it)."""
+    surface = icosphere(1.0, 3)
+    tri = surface.triangles
+    surf_edge = np.linalg.norm(surface.points[tri[:, 1]] - surface.points[tri[:, 0]], axis=1).mean()
+    plain, _ = core.tetrahedralize(surface, options={"size": 2.0})
+    graded, _ = core.tetrahedralize(surface, options={"size": 2.0, "size_from_surface": True})
+    assert core.check_mesh(surface, graded)["valid"]
+    lp, lg = edge_lengths(plain), edge_lengths(graded)
+    print("surface edge %.3f; longest tet edge: plain %.3f, graded %.3f; tets %d -> %d"
+          % (surf_edge, lp.max(), lg.max(), len(plain.tets), len(graded.tets)))
+    assert lg.max() < 0.75 * lp.max()
+    assert lg.max() <= 2.0 * 2.0 * surf_edge + 0.5  # graded 0.5 per unit from the surface
+    assert len(graded.tets) > len(plain.tets)
+
+
 def test_bad_refinement_options_are_input_errors():
     surface = read_surface(corpus_path("cube"))
     with pytest.raises(InputError, match="size"):

@@ -110,7 +110,8 @@ def test_tet10_on_remeshed_plate_with_hole_is_valid_and_on_the_cad(fc):
     freecad, Part, _ = fc
     shape = placed(fc, Part.makeBox(60, 40, 8).cut(
         Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0))))
-    params = mesh_pipeline.MeshParameters(max_size=6.0, order=2, compare_tetgen=False)
+    params = mesh_pipeline.MeshParameters(max_size=6.0, order=2, compare_tetgen=False,
+                                          remesh_surface=True)
     result = mesh_pipeline.mesh_cad_shape(shape, params)
     st = result.stats["surface_remesh"]
     print("remesh:", st, "min dihedral", result.stats["min_dihedral_deg"])
@@ -163,7 +164,8 @@ def test_a_remeshed_surface_the_core_refuses_falls_back_to_the_tessellation(fc, 
         return bad, {"triangles_before": len(surface.triangles)}
 
     monkeypatch.setattr(sr, "remesh_surface", broken)
-    params = mesh_pipeline.MeshParameters(max_size=4.0, order=1, compare_tetgen=False)
+    params = mesh_pipeline.MeshParameters(max_size=4.0, order=1, compare_tetgen=False,
+                                          remesh_surface=True)
     result = mesh_pipeline.mesh_cad_shape(placed(fc, Part.makeBox(10, 12, 14)), params)
     assert any("remeshing" in n and "not used" in n for n in result.notes), result.notes
     assert len(result.mesh.tets) > 0

@@ -108,6 +108,19 @@ class Refiner {
         if (it == o_.size_by_tag.end()) continue;
         for (Index v : face) target_[static_cast<std::size_t>(v)] = std::min(target_[static_cast<std::size_t>(v)], it->second);
       }
+    if (o_.size_from_surface) {
+      const SurfaceMesh& in = m_.surface();
+      for (const auto& [face, parent] : m_.boundary_faces()) {
+        const Index* t = &in.tri[static_cast<std::size_t>(3 * parent)];
+        double mean = 0;
+        for (int k = 0; k < 3; ++k) {
+          const std::size_t a = static_cast<std::size_t>(3 * t[k]), b = static_cast<std::size_t>(3 * t[(k + 1) % 3]);
+          const double dx = in.xyz[a] - in.xyz[b], dy = in.xyz[a + 1] - in.xyz[b + 1], dz = in.xyz[a + 2] - in.xyz[b + 2];
+          mean += std::sqrt(dx * dx + dy * dy + dz * dz) / 3;
+        }
+        for (Index v : face) target_[static_cast<std::size_t>(v)] = std::min(target_[static_cast<std::size_t>(v)], mean);
+      }
+    }
     // Grading: t(v) <= t(u) + grading * |uv|.
     std::vector<std::vector<Index>> nbr(static_cast<std::size_t>(np));
     for (const auto& e : m_.edges()) {
@@ -274,7 +287,7 @@ class Refiner {
   // The offending tets (see the option), each with the edges whose split would mend it, best
   // first: interior edges (their midpoint is off every face), then edges of other tags' faces;
   // longer first.
-  std::vector<std::vector<std::array<Index, 2>>> tag_conflicts() {
+  std::vector<std::pair<Index, std::vector<std::array<Index, 2>>>> tag_conflicts() {
     using Key3 = std::array<Index, 3>;
     std::map<Key3, std::int32_t> face_tag;                                // sorted boundary face -> tag
     std::map<std::array<Index, 2>, std::vector<std::int32_t>> edge_tags;  // boundary edge -> tags
@@ -296,7 +309,7 @@ class Refiner {
       const auto& pt = point_tags[static_cast<std::size_t>(v)];
       return std::find(pt.begin(), pt.end(), tag) != pt.end();
     };
-    std::vector<std::vector<std::array<Index, 2>>> out;
+    std::vector<std::pair<Index, std::vector<std::array<Index, 2>>>> out;
     for (Index t = 0; t < m_.num_tet_slots(); ++t) {
       if (!m_.tet_alive(t)) continue;
       const auto q = m_.tet(t);
@@ -328,24 +341,40 @@ class Refiner {
         std::sort(ranked.begin(), ranked.end());
         std::vector<std::array<Index, 2>> edges;
         for (const auto& r : ranked) edges.push_back({std::get<2>(r), std::get<3>(r)});
-        out.push_back(std::move(edges));
+        out.emplace_back(t, std::move(edges));
         break;
       }
     }
     return out;
   }
 
+  static constexpr double kTagSplitMinDihedral = 1.0;  // degrees
+
   void separate_face_tags() {
     for (int pass = 0; pass < 16; ++pass) {
       poll("separating CAD faces", 0.9);
       std::int64_t done = 0;
-      for (const auto& edges : tag_conflicts())
+      // A split may not make a tet flatter than kTagSplitMinDihedral: where the face is flat
+      // (a plane, a nearly flat strip) the midpoint of an interior edge between two of its
+      // points lies on it, and splitting there made flat tets on the face instead of mending
+      // one (part.step: 0.0025 degrees). Then a new interior point above the tet (insert_for).
+      for (const auto& [t, edges] : tag_conflicts()) {
+        bool mended = false;
+        // split_edge bounds new tets by min(this, the worst old tet): a flat conflict tet gets
+        // no split (it would only make more flat tets), only insert_for below
+        const bool flat = m_.tet_alive(t) && m_.tet_quality(t) < kTagSplitMinDihedral;
         for (const auto& e : edges)
-          if (m_.point_alive(e[0]) && m_.point_alive(e[1]) && split(e[0], e[1], 0)) {
-            ++done;
+          if (!flat && m_.point_alive(e[0]) && m_.point_alive(e[1]) && split(e[0], e[1], kTagSplitMinDihedral)) {
             ++st_.tag_splits;
+            mended = true;
             break;
           }
+        if (!mended && m_.tet_alive(t) && insert_for(t)) {
+          ++st_.tag_splits;
+          mended = true;
+        }
+        if (mended) ++done;
+      }
       if (done == 0) break;
     }
     st_.tag_conflicts_left = static_cast<std::int64_t>(tag_conflicts().size());

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 #include <vector>
 
 namespace bsptet {
@@ -84,6 +85,14 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
   std::vector<Vec3> straight(edges.size());
   std::vector<char> curved(edges.size(), 0);
   SecondOrderStats st;
+  // Every node's coordinates: a projected mid-node that lands exactly on another node (the hook
+  // clamps to a CAD vertex when the edge is not along the CAD edge of its two faces) stays on its
+  // chord, or the mesh would have two nodes at one place (not conforming).
+  std::set<std::array<double, 3>> taken;
+  for (Index v = 0; v < np; ++v) {
+    const Vec3 q = lin.point(v);
+    taken.insert({q.x, q.y, q.z});
+  }
   for (std::size_t i = 0; i < edges.size(); ++i) {
     const Vec3 a = lin.point(edges[i][0]), b = lin.point(edges[i][1]);
     straight[i] = {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)};
@@ -92,12 +101,13 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
     if (hook && it != boundary_edge_tags.end()) {
       const auto tags = it->second;
       const Vec3 q = hook(p, tags[0], tags[1] != tags[0] ? tags[1] : -1);
-      if (std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z)) {
+      if (std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && !taken.count({q.x, q.y, q.z})) {
         curved[i] = q.x != p.x || q.y != p.y || q.z != p.z;  // a straight edge of the surface: 0
         p = q;
         ++st.projected;
       }
     }
+    taken.insert({p.x, p.y, p.z});
     out.xyz.insert(out.xyz.end(), {p.x, p.y, p.z});
   }
   auto edge_id = [&](Index a, Index b) {

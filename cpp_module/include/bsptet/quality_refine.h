@@ -50,6 +50,11 @@ struct RefineOptions {
   double min_size = 0;
   /// Target size near the input triangles of a face tag (a CAD face), model units.
   std::map<std::int32_t, double> size_by_tag;
+  /// Also lower the target at the corners of every input triangle to that triangle's mean edge
+  /// length (as Gmsh's Mesh.MeshSizeExtendFromBoundary): the volume grades from a surface that
+  /// is already meshed to size (a remeshed CAD surface) instead of meeting small surface
+  /// triangles with tets of `size`, which are flat there.
+  bool size_from_surface = false;
   /// How fast the target grows away from smaller sizes: at most `grading` per unit length.
   double grading = 0.5;
   /// An edge is split when longer than split_ratio * target (1.0 would make `size` a strict
