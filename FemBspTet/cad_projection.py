@@ -57,6 +57,8 @@ class CadProjection:
         if not self._faces:
             raise InputError("the shape has no faces: nothing to project onto")
         self._edges_of_pair = {}
+        #: Tag tuples of every to_faces call whose faces share no CAD edge or vertex.
+        self.disjoint_placements = []
 
     @property
     def face_count(self):
@@ -125,7 +127,10 @@ class CadProjection:
         One tag: :meth:`to_face`. Two tags: the nearest point on a CAD edge the two faces
         share (the nearest over all such edges). More tags, or two faces without a common edge
         (the point is where a vertex of the tessellation would be): the nearest CAD vertex
-        shared by all the faces. Raises InputError if the faces share no edge/vertex.
+        shared by all the faces. Faces that share no edge or vertex (coinciding faces of
+        touching solids, or faces the tessellation joined across a sliver face that got no
+        triangles): the nearest point of the nearest of them, and the tags are appended to
+        ``disjoint_placements``.
         """
         tags = sorted({int(t) for t in face_tags})
         if not tags:
@@ -148,8 +153,13 @@ class CadProjection:
             vertices = vs if vertices is None else [v for v in vertices
                                                     if any(v.isSame(w) for w in vs)]
         if not vertices:
-            raise InputError("faces %s have no common CAD edge or vertex: a mesh point cannot "
-                             "lie on all of them" % ", ".join("Face%d" % (t + 1) for t in tags))
+            # Faces that share no edge or vertex: coinciding faces of two touching solids, or
+            # faces the tessellation joins across a sliver face that got no triangles. No point
+            # is on all of them in general: the nearest point of the nearest face, recorded for
+            # the caller's notes.
+            best = min((self.to_face(point, t) for t in tags), key=lambda q: _dist2(q, point))
+            self.disjoint_placements.append(tuple(tags))
+            return best
         best = min(vertices, key=lambda v: _dist2((v.X, v.Y, v.Z), point))
         return (best.X, best.Y, best.Z)
 

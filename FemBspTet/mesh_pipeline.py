@@ -319,6 +319,7 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     best = None
     for attempt in range(rounds + 1):
         remesh_notes, remesh_stats = [], {}
+        projection.disjoint_placements.clear()
         if params.remesh_surface:
             report("remeshing the CAD faces" if attempt == 0 else
                    "remeshing the CAD faces finer where curved tet10s inverted (round %d)"
@@ -370,6 +371,15 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     if remesh_stats:
         stats["surface_remesh"] = remesh_stats
     notes = remesh_notes + list(stats.get("notes", []))
+    if projection.disjoint_placements:
+        pairs = sorted({", ".join("Face%d" % (t + 1) for t in ts)
+                        for ts in projection.disjoint_placements})
+        notes.append(
+            "%d boundary node(s) belong to CAD faces that share no edge or vertex (%s%s): faces "
+            "of touching solids that coincide, or faces the tessellation joins across a face too "
+            "small to get triangles; each node was put on the nearest of them"
+            % (len(projection.disjoint_placements), "; ".join(pairs[:4]),
+               " and %d more" % (len(pairs) - 4) if len(pairs) > 4 else ""))
     if kept:
         worst = max(d for _, d in kept.values())
         faces_named = sorted({"Face%d" % (t + 1) for ts, _ in kept.values() for t in ts})
@@ -475,10 +485,11 @@ def boundary_faces_of(tets):
 def boundary_faces_with_tags(mesh, surfaces):
     """Boundary triangles of ``mesh`` and the CAD face tag of each.
 
-    A boundary triangle whose three corners are exactly the corners of an input triangle takes
-    its tag (exact coordinate match: the core's boundary is the input triangulation). One with a
-    boundary Steiner point lies inside an input triangle: it takes the tag of the input triangle
-    nearest to its centroid. Raises InternalError if the surfaces carry no tags.
+    A boundary triangle whose three corners are exactly the corners of an input triangle, in the
+    same cyclic order, takes its tag (exact coordinate match: the core's boundary is the input
+    triangulation; the order tells apart the coinciding faces of touching solids). One with a
+    boundary Steiner point lies inside an input triangle: it takes the tag of the nearest input
+    triangle facing the same way. Raises InternalError if the surfaces carry no tags.
     """
     faces = boundary_faces_of(mesh.tets)
     pts = mesh.points
@@ -496,15 +507,27 @@ def boundary_faces_with_tags(mesh, surfaces):
         all_pts = [s.points[s.triangles] for s in surfaces]
         all_tags = np.concatenate([s.face_tags for s in surfaces])
         tri_pts = np.concatenate(all_pts)
+        tri_normals = np.cross(tri_pts[:, 1] - tri_pts[:, 0], tri_pts[:, 2] - tri_pts[:, 0])
         for k in missing.tolist():
-            centroid = pts[faces[k]].mean(axis=0)
-            tags[k] = all_tags[int(np.argmin(_point_triangle_dist2(centroid, tri_pts)))]
+            corners = pts[faces[k]]
+            centroid = corners.mean(axis=0)
+            d2 = _point_triangle_dist2(centroid, tri_pts)
+            # among the nearest input triangles, one facing the same way (a touching solid's
+            # coinciding face faces the other way)
+            normal = np.cross(corners[1] - corners[0], corners[2] - corners[0])
+            d2 = np.where(tri_normals @ normal > 0, d2, d2 + np.inf)
+            if not np.isfinite(d2).any():
+                d2 = _point_triangle_dist2(centroid, tri_pts)
+            tags[k] = all_tags[int(np.argmin(d2))]
     return faces, tags
 
 
 def _corner_key(three_points):
-    rows = sorted(map(tuple, np.asarray(three_points, dtype=np.float64).tolist()))
-    return tuple(rows)
+    """The triangle's corners in their cyclic order, starting at the smallest: oriented, so
+    that the coinciding faces of two touching solids (opposite orientations) differ."""
+    rows = [tuple(r) for r in np.asarray(three_points, dtype=np.float64).tolist()]
+    k = rows.index(min(rows))
+    return tuple(rows[k:] + rows[:k])
 
 
 def _point_triangle_dist2(p, tri):

@@ -4,7 +4,7 @@ time limit: either a mesh (nodes, tets, seconds, boundary nodes put on the CAD) 
 user would see. Usage:
 
     bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--size-of-diagonal F]
-                                [--timeout S] [--markdown F]
+                                [--timeout S] [--markdown F] [--remesh-surface]
 
 Default folder: tests/data/cad. Prints one row per file.
 """
@@ -34,11 +34,14 @@ def main():
     ap.add_argument("--size-of-diagonal", type=float, default=0.0, metavar="F",
                     help="CharacteristicLengthMax = F * the shape's bounding-box diagonal "
                          "(default 0: automatic, the mesher object's default)")
+    ap.add_argument("--remesh-surface", action="store_true",
+                    help="RemeshSurface on (FemBspTet.surface_remesh; default off, as the object)")
     args = ap.parse_args()
     import_freecad()
     import Part
 
-    rows = [("file", "solids", "faces", "result", "nodes", "tets", "seconds")]
+    rows = [("file", "solids", "faces", "result", "nodes", "tets", "seconds", "min dihedral",
+             "1% dihedral")]
     for path in model_paths(args.inputs, CAD_FORMATS):
         name = os.path.basename(path)
         t0 = time.perf_counter()
@@ -49,7 +52,8 @@ def main():
             print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
         size = args.size_of_diagonal * shape.BoundBox.DiagonalLength
-        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False),
+        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False,
+                                              remesh_surface=args.remesh_surface),
                       source=name, python="/usr/bin/python3")
         job.start()
         if not job.wait(args.timeout):
@@ -60,8 +64,10 @@ def main():
             continue
         try:
             r = job.result()
+            p1 = r.stats.get("p1_dihedral_deg")
             rows.append((name, len(shape.Solids), len(shape.Faces), "ok", len(r.mesh.points),
-                         len(r.mesh.tets), "%.1f" % (time.perf_counter() - t0)))
+                         len(r.mesh.tets), "%.1f" % (time.perf_counter() - t0),
+                         "%.2f" % r.stats["min_dihedral_deg"], "" if p1 is None else "%.1f" % p1))
         except BspTetError as e:
             msg = str(e).replace("\n", " ")
             rows.append((name, len(shape.Solids), len(shape.Faces),

@@ -147,6 +147,35 @@ def test_bad_face_tag_is_an_input_error(fc):
     proj = CadProjection(Part.makeBox(1, 1, 1))
     with pytest.raises(InputError, match="face tag 6 is not a face"):
         proj((0, 0, 0), 6)
-    with pytest.raises(InputError, match="no common CAD edge or vertex"):
-        # Face1 (x=0) and Face2 (x=1) of a box are opposite
-        proj.to_faces((0.5, 0.5, 0.5), {0, 1})
+    # Face1 (x=0) and Face2 (x=1) of a box are opposite: no point is on both; the nearest
+    # point of the nearer face, recorded
+    assert proj.to_faces((0.25, 0.5, 0.5), {0, 1}) == (0.0, 0.5, 0.5)
+    assert proj.to_faces((0.75, 0.5, 0.5), {0, 1}) == (1.0, 0.5, 0.5)
+    assert proj.disjoint_placements == [(0, 1), (0, 1)]
+
+
+def test_touching_solids_keep_their_own_faces(fc):
+    """Two boxes of a compound touching at x = 10: the coinciding contact faces are told apart
+    by orientation, so every boundary triangle there takes its own solid's face and no node is
+    put on a face of the other solid (before: "faces Face2, Face7 have no common CAD edge")."""
+    freecad, Part, _ = fc
+    from FemBspTet import mesh_pipeline as mp
+
+    a = Part.makeBox(10, 10, 10)
+    b = Part.makeBox(10, 10, 10, freecad.Vector(10, 0, 0))
+    shape = Part.makeCompound([a, b])
+    result = mp.mesh_cad_shape(shape, mp.MeshParameters(max_size=4, order=2))
+    assert not result.notes, result.notes
+    pts = result.mesh.points
+    faces = result.boundary_faces
+    on_contact = np.all(pts[faces][:, :, 0] == 10.0, axis=1)
+    normals = np.cross(pts[faces[:, 1]] - pts[faces[:, 0]], pts[faces[:, 2]] - pts[faces[:, 0]])
+    contact_tags = {+1: set(), -1: set()}
+    for k in np.nonzero(on_contact)[0].tolist():
+        contact_tags[int(np.sign(normals[k, 0]))].add(int(result.boundary_face_tags[k]))
+    (plus,), (minus,) = contact_tags[+1], contact_tags[-1]
+    of_solid = [{k for k, f in enumerate(shape.Faces) if any(f.isSame(g) for g in sol.Faces)}
+                for sol in shape.Solids]
+    # outward +x at x = 10 is the first box's face, outward -x the second box's
+    assert plus in of_solid[0] and plus not in of_solid[1]
+    assert minus in of_solid[1] and minus not in of_solid[0]
