@@ -177,3 +177,25 @@ def test_quality_stats_of_an_equilateral_and_a_needle():
     assert abs(qmin - 1) < 1e-12 and abs(amin - 60) < 1e-9
     qmin, _, amin = triangle_quality_stats(pts, np.array([[0, 1, 3]]))
     assert qmin < 1e-3 and amin < 0.01
+
+
+def test_inverted_tet10_is_found_and_refinement_points_sit_on_it():
+    """The pipeline's local refinement rounds: a tet10 whose mid-node was moved through the
+    opposite face is reported, the untouched one is not, and the size point asked for it is at
+    its centroid with half its longest edge."""
+    from FemBspTet.mesh_types import TetMesh
+
+    corners = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]], float)
+    edges = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
+    mids = np.array([(corners[i] + corners[j]) / 2 for i, j in edges])
+    pts = np.vstack([corners, mids, corners + [10, 0, 0], mids + [10, 0, 0]])
+    tets = np.array([list(range(10)), list(range(10, 20))])
+    mesh = TetMesh(pts, tets)
+    assert len(mesh_pipeline.elements_inverted_by_projection(mesh, np.array([4, 14]))) == 0
+    mesh.points[14] = [11.0, 0.0, 3.0]  # m12 of the second tet pulled far past the apex
+    bad = mesh_pipeline.elements_inverted_by_projection(mesh, np.array([4, 14]))
+    assert bad.tolist() == [1]
+    sp = mesh_pipeline.refinement_points(mesh, bad)
+    assert np.allclose(sp[0, :3], corners.mean(axis=0) + [10, 0, 0])
+    assert np.isclose(sp[0, 3], 0.5 * 2 * math.sqrt(2))
+    assert np.isclose(mesh_pipeline.refinement_points(mesh, bad, min_size=5.0)[0, 3], 5.0)
