@@ -343,18 +343,17 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         moved, max_move, kept = place_boundary_nodes_on_cad(
             mesh, faces, tags, midnodes, input_points, projection, cancel=check_cancel)
         bad = elements_inverted_by_projection(mesh, moved)
-        if best is None or len(bad) < best[0]:
-            best = (len(bad), attempt, (surfaces, remesh_notes, remesh_stats, mesh, stats, faces,
-                                        tags, midnodes, moved, max_move, kept))
-        elif len(bad) >= best[0]:
+        if best is not None and len(bad) >= len(best[-1]):
             break  # refining made it no better: keep the best attempt
+        best = (attempt, surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes,
+                moved, max_move, kept, bad)
         if len(bad) == 0 or attempt == rounds:
             break
         size_points = np.vstack([size_points, refinement_points(mesh, bad, params.min_size)])
-    _, attempt, (surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes, moved,
-                 max_move, kept) = best
+    (attempt, surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes, moved,
+     max_move, kept, bad) = best
     check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
-                                    stats.get("min_dihedral_deg"))
+                                    stats.get("min_dihedral_deg"), bad=bad)
     if attempt:
         remesh_stats["local_refinement_rounds"] = attempt
     check_cancel()
@@ -711,32 +710,24 @@ def refinement_points(mesh, tets, min_size=0.0):
     return np.column_stack([corners.mean(axis=1), size])
 
 
-def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_dihedral=None):
+def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_dihedral=None,
+                                    bad=None):
     """Raise InternalError if a tet with a moved node is inverted or (tet10) has a non-positive
     Jacobian determinant at a node or the centroid. The message names the tet and CAD face.
 
     This happens when a tet next to a curved face is thinner than the distance its mid-nodes
     move (the chord sag): flat tets (dihedral angles near 0 or 180 degrees) that only quality
-    refinement of the core removes; ``min_dihedral`` (degrees) is quoted in the message."""
-    if len(moved) == 0:
-        return
-    is_moved = np.zeros(len(mesh.points), dtype=bool)
-    is_moved[moved] = True
-    touched = np.nonzero(is_moved[mesh.tets].any(axis=1))[0]
-    t = mesh.tets[touched]
-    p = mesh.points
-    a, b, c, d = (p[t[:, i]] for i in range(4))
-    vol6 = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)
-    bad = vol6 <= 0
-    if t.shape[1] == 10:
-        bad |= (tet10_jacobians(p, t) <= 0).any(axis=1)
-    if bad.any():
-        e = int(touched[np.nonzero(bad)[0][0]])
+    refinement of the core removes; ``min_dihedral`` (degrees) is quoted in the message.
+    ``bad``: the result of :func:`elements_inverted_by_projection` if the caller has it."""
+    if bad is None:
+        bad = elements_inverted_by_projection(mesh, moved)
+    if len(bad):
+        e = int(bad[0])
         node_set = set(mesh.tets[e].tolist())
         where = sorted({face_names[g] for f, g in zip(faces.tolist(), tags.tolist())
                         if set(f) <= node_set})
         at = " (at %s)" % ", ".join(where) if where else ""
-        if t.shape[1] == 10:
+        if mesh.tets.shape[1] == 10:
             flat = ("; the mesh's worst dihedral angle is %.3g degrees: elements next to the "
                     "curved face are thinner than the distance their mid-nodes move onto it"
                     % min_dihedral) if min_dihedral is not None else ""
@@ -744,7 +735,7 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
                 "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
                 "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
                 "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "
-                "on the CAD faces)" % (int(bad.sum()), e, at, flat))
+                "on the CAD faces)" % (len(bad), e, at, flat))
         flat = ("; the mesh's worst dihedral angle is %.3g degrees" % min_dihedral
                 if min_dihedral is not None else "")
         raise InternalError(
@@ -754,4 +745,4 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
             "the CAD face would not be found by the constraints). A smaller LinearDeflection "
             "(a tessellation closer to the CAD faces), a larger CharacteristicLengthMax, or "
             "CharacteristicLengthMax 0 (no boundary nodes added) avoids it"
-            % (int(bad.sum()), e, at, flat))
+            % (len(bad), e, at, flat))

@@ -549,7 +549,6 @@ class _Remesher:
             return False
         if _dist(m, mid) > 0.5 * length:
             self.count["refused"] += 1
-            self.count["refused_far"] = self.count.get("refused_far", 0) + 1
             return False
         new_id = len(self.P)
         pos = {new_id: m}
@@ -574,7 +573,6 @@ class _Remesher:
 
         ok = all(child_ok(t1, t) and child_ok(t2, t) for t, t1, t2 in plan)
         if not ok:
-            self.count["refused_fold"] = self.count.get("refused_fold", 0) + 1
             self.P.pop()
             self.refn.pop()
             self.count["refused"] += 1
