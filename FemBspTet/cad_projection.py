@@ -10,7 +10,12 @@ options={"projection": hook})``)::
                  :mod:`FemBspTet.cad_tessellation`)
       other_tag: -1, or the second face when the point is on a surface edge between two CAD
                  faces (then the point goes onto their common CAD edge)
-      returns:  a tuple of 3 floats, the nearest point of the trimmed CAD face
+      returns:  a tuple of 3 floats, the nearest point of the trimmed CAD face; for a point of
+                one face (other_tag -1) whose nearest point of the untrimmed surface lies
+                outside the trimmed face, three NaNs: the core then refuses the point (the
+                nearest point of the bounded face is on a CAD edge, where a vertex the mesh
+                treats as inside the face would make a flat "fin" triangle);
+                :meth:`CadProjection.to_face` always gives the nearest point
 
 :class:`CadProjection` is that hook for one ``Part.Shape``. It also projects onto the CAD edge
 shared by two faces (:meth:`CadProjection.to_faces`), which is where a tet10 mid-node of a
@@ -83,20 +88,37 @@ class CadProjection:
         other_tag = int(other_tag)
         if other_tag >= 0 and other_tag != int(face_tag):
             return self.to_faces(point, (face_tag, other_tag))
-        return self.to_face(point, face_tag)
+        q, inside = self._to_face(point, face_tag)
+        if not inside:
+            # The point is inside one face's triangles but its nearest point of the surface is
+            # outside the trimmed face: it sits in the sliver between a chord of the
+            # tessellation and the curved CAD edge. Its nearest point of the bounded face is on
+            # that CAD edge, where the mesh would treat it as a point inside the face: a flat
+            # "fin" triangle with three corners on one CAD edge, under which every tet10 folds.
+            # Refused (non-finite: the core does not insert it; a tet10 mid-node stays on its
+            # chord there and the FreeCAD placement puts it on the face afterwards).
+            nan = float("nan")
+            return (nan, nan, nan)
+        return q
 
     def to_face(self, point, face_tag):
         """The nearest point of the trimmed face ``face_tag`` to ``point`` (3 floats)."""
+        return self._to_face(point, face_tag)[0]
+
+    def _to_face(self, point, face_tag):
+        """``(to_face(point, face_tag), whether the surface's own nearest point was inside the
+        trimmed face)``."""
         face = self.face(face_tag)
         p = self._vector(*map(float, point))
         try:
             u, v = face.Surface.parameter(p)
             if face.isPartOfDomain(u, v):
                 q = face.Surface.value(u, v)
-                return (q.x, q.y, q.z)
+                return (q.x, q.y, q.z), True
         except Exception:  # OCCT's projection did not converge: use the bounded-face search
             pass
-        return self._nearest_on_shape(face, p, "Face%d" % (int(face_tag) + 1))
+        q = self._nearest_on_shape(face, p, "Face%d" % (int(face_tag) + 1))
+        return q, False
 
     def to_edge(self, point, edge):
         """The nearest point of the bounded ``Part.Edge`` ``edge`` to ``point``."""

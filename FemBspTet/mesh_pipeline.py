@@ -22,9 +22,15 @@ Stages:
 4. Every boundary node that is not a tessellation vertex is put on its CAD geometry: tet10
    mid-nodes of surface edges inside a face onto that face, those of edges between two faces
    onto the CAD edge the faces share, boundary Steiner points likewise. Tessellation vertices
-   already lie on their faces and are not moved. Interior mid-nodes stay straight
-   (``/work/shared/design/freecad.md`` §7, mesh contract). Projection is idempotent, so this is
+   already lie on their faces and are not moved. Interior mid-nodes stay straight unless
+   bending them is what keeps an element valid (``/work/shared/design/freecad.md`` §7 allows
+   both). Projection is idempotent, so this is
    harmless when the core already applied the hook.
+   tet10: an element that the curved boundary would invert gets its interior edges bent
+   (:mod:`FemBspTet.curved_untangle`: interior mid-nodes move, boundary nodes never); if some
+   elements stay inverted, one more attempt meshes the tessellation with its folding curved
+   triangles mended (:func:`repair_curved_folds_of`), and the attempt with fewer inverted
+   elements is kept.
 5. Moved nodes must not invert an element: every tet with a moved node is checked (positive
    signed volume of the corners; for tet10 a positive Jacobian determinant at the 10 nodes and
    the centroid). A failure raises InternalError naming the tet and the CAD face.
@@ -311,7 +317,10 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         options[CORE_OPTION_OF["max_size"]] = float(element_size)
     tessellation = surfaces
     size_points = np.zeros((0, 4))
-    rounds = LOCAL_REFINEMENT_ROUNDS if params.remesh_surface and params.order == 2 else 0
+    # tet10: with RemeshSurface, rounds of local refinement; without, one more attempt on the
+    # tessellation with its folding curved triangles mended (repair_curved_folds_of), kept only
+    # if it inverts fewer elements (it helps some parts and not others: measured, session 10)
+    rounds = (LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else 1) if params.order == 2 else 0
 
     def core_progress(stage, fraction):
         report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
@@ -327,11 +336,20 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
             surfaces, remesh_notes, remesh_stats = remesh_cad_surfaces(
                 tessellation, projection, element_size, params, deflection, cancel=check_cancel,
                 size_points=size_points)
+        fold_stats = {}
+        if attempt == 1 and not params.remesh_surface:
+            report("mending tessellation triangles whose curved tet10 faces would fold", 0.03)
+            surfaces, fold_stats = repair_curved_folds_of(tessellation, projection,
+                                                          cancel=check_cancel)
+            if fold_stats["folded_after"] >= fold_stats["folded_before"]:
+                break  # nothing mended: the first attempt stands
         try:
             mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
                                               cancel=cancel)
         except BspTetError:
             check_cancel()  # the core stopped because cancel() said so (whatever it raised)
+            if best is not None and not params.remesh_surface:
+                break  # the mended surface failed where the tessellation did not: keep that
             raise
         check_cancel()
 
@@ -343,6 +361,16 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         moved, max_move, kept = place_boundary_nodes_on_cad(
             mesh, faces, tags, midnodes, input_points, projection, cancel=check_cancel)
         bad = elements_inverted_by_projection(mesh, moved)
+        if len(bad) and mesh.tets.shape[1] == 10:
+            report("bending interior edges of curved tet10 elements", 0.88)
+            bad, bent = bend_interior_edges(mesh, midnodes, bad, cancel=check_cancel)
+            fold_stats["bent_interior_midnodes"] = int(len(bent))
+            if len(bent):
+                moved = np.union1d(moved, bent)
+                bad = elements_inverted_by_projection(mesh, moved)
+        if fold_stats:
+            stats = dict(stats)
+            stats["curved_repair"] = fold_stats
         if best is not None and len(bad) >= len(best[-1]):
             break  # refining made it no better: keep the best attempt
         best = (attempt, surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes,
@@ -354,8 +382,11 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
      max_move, kept, bad) = best
     check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
                                     stats.get("min_dihedral_deg"), bad=bad)
-    if attempt:
+    if attempt and params.remesh_surface:
         remesh_stats["local_refinement_rounds"] = attempt
+    elif attempt:
+        stats = dict(stats)
+        stats["curved_repair"] = dict(stats.get("curved_repair", {}), used=True)
     check_cancel()
 
     report("looking for interior nodes within the CAD face tolerance", 0.9)
@@ -452,6 +483,59 @@ def remesh_cad_surfaces(surfaces, projection, size, params, deflection, cancel=N
                 total[k] = total.get(k, 0) + v
         out.append(new)
     return out, notes, total
+
+
+def shared_face_tags(surfaces):
+    """Face tags that appear in more than one solid's surface (faces two solids share: both
+    sides must stay identical, so they are never changed)."""
+    counts = {}
+    for surf in surfaces:
+        for tag in set(surf.face_tags.tolist()):
+            counts[tag] = counts.get(tag, 0) + 1
+    return {tag for tag, c in counts.items() if c > 1}
+
+
+def repair_curved_folds_of(surfaces, projection, cancel=None):
+    """Each solid's tessellation through :func:`FemBspTet.surface_remesh.repair_curved_folds`
+    (tet10 only). A repaired surface is used only if it has fewer folded triangles and passes
+    the core's exact input check; else the solid keeps its tessellation. Returns ``(surfaces,
+    stats)``, stats summed over the solids (``folded_before``, ``folded_after``, ``flips``,
+    ``splits``, ``seconds``, ``not_used``)."""
+    from . import core
+    from .errors import InputError
+    from .surface_remesh import RemeshError, repair_curved_folds
+
+    frozen = shared_face_tags(surfaces)
+    out, total = [], {"folded_before": 0, "folded_after": 0, "flips": 0, "splits": 0,
+                      "seconds": 0.0, "not_used": 0}
+    for surf in surfaces:
+        try:
+            new, st = repair_curved_folds(surf, projection, frozen_tags=frozen, cancel=cancel)
+            if new is not surf:
+                if st["folded_after"] >= st["folded_before"]:
+                    raise RemeshError("no better")
+                core.check_surface(new)
+        except (RemeshError, InputError):
+            total["not_used"] += 1
+            out.append(surf)
+            continue
+        for k in ("folded_before", "folded_after", "flips", "splits", "seconds"):
+            total[k] += st[k]
+        out.append(new)
+    return out, total
+
+
+def bend_interior_edges(mesh, midnodes, bad, cancel=None):
+    """:func:`FemBspTet.curved_untangle.untangle_interior_midnodes` on the elements ``bad`` of
+    a tet10 mesh whose boundary mid-nodes are ``midnodes``: only interior mid-nodes move.
+    Returns ``(still bad, moved nodes)``."""
+    from .curved_untangle import untangle_interior_midnodes
+
+    movable = np.zeros(len(mesh.points), dtype=bool)
+    movable[mesh.tets[:, 4:10].reshape(-1)] = True
+    if len(midnodes):
+        movable[np.asarray(midnodes).reshape(-1)] = False
+    return untangle_interior_midnodes(mesh.points, mesh.tets, bad, movable, cancel=cancel)
 
 
 def shape_face_names(projection):

@@ -115,6 +115,32 @@ def triangle_quality_stats(points, triangles):
     return float(q.min()), float(np.median(q)), float(a.min())
 
 
+def _curved_triangle_measure(x):
+    """x: (6, 3) corners a, b, c and mid-nodes of ab, bc, ca of a 6-node triangle. Smallest
+    n(L) . n_flat / |n_flat|^2 over the corners, edge midpoints and centroid."""
+    nflat = np.cross(x[1] - x[0], x[2] - x[0])
+    den = float(nflat @ nflat)
+    if not den > 0:
+        return -math.inf
+    worst = math.inf
+    for lam in _TRI_SAMPLES:
+        g = []
+        for i in range(3):
+            gi = (4.0 * lam[i] - 1.0) * x[i]
+            for e, (p, q) in enumerate(((0, 1), (1, 2), (2, 0))):
+                if p == i:
+                    gi = gi + 4.0 * lam[q] * x[3 + e]
+                elif q == i:
+                    gi = gi + 4.0 * lam[p] * x[3 + e]
+            g.append(gi)
+        worst = min(worst, float(np.cross(g[1] - g[0], g[2] - g[0]) @ nflat) / den)
+    return worst
+
+
+_TRI_SAMPLES = [np.eye(3)[i] for i in range(3)] + \
+    [0.5 * (np.eye(3)[i] + np.eye(3)[(i + 1) % 3]) for i in range(3)] + [np.full(3, 1.0 / 3.0)]
+
+
 class RemeshError(Exception):
     """The remesher could not make a surface (the caller keeps the tessellation)."""
 
@@ -175,9 +201,67 @@ def remesh_surface(surface, projection, size, linear_deflection, angular_deflect
     return out, stats
 
 
+#: A curved (6-node) boundary triangle counts as folded where its area element, relative to
+#: the flat triangle's, drops below this anywhere it is sampled (:func:`repair_curved_folds`).
+CURVED_FOLD_THRESHOLD = 0.0
+#: Rounds of :func:`repair_curved_folds` at most.
+FOLD_REPAIR_ROUNDS = 8
+#: Generations of split points :func:`repair_curved_folds` may make around one fold.
+MAX_FOLD_SPLIT_DEPTH = 4
+
+
+def repair_curved_folds(surface, projection, frozen_tags=(), rounds=FOLD_REPAIR_ROUNDS,
+                        cancel=None, cad_vertices=None):
+    """Change the tessellation only where its curved tet10 version would fold.
+
+    A tet10 mid-node of a surface edge goes onto the CAD face (or onto the CAD edge of its two
+    faces). Where a tessellation triangle is a needle along a curved CAD edge or a sliver face
+    that tapers to a point, its two long edges bulge by different amounts and the curved
+    triangle folds over near its sharp corner: every tet on it then has a negative Jacobian
+    there, whatever is done inside. This finds the triangles whose 6-node version (corners and
+    the CAD points of their edges' midpoints) has an area element below
+    ``CURVED_FOLD_THRESHOLD`` times the flat one's somewhere (corners, edge midpoints, centroid),
+    and mends each one locally: by flipping one of its edges inside its CAD face when both new
+    triangles are better, or else by splitting its edge of largest sag at that edge's CAD point
+    (which divides the sag by four). Nothing else moves: no smoothing, no collapse, no size
+    field; the rest of the tessellation stays exactly as it was. Faces in ``frozen_tags`` are
+    left alone.
+
+    Returns ``(Surface, stats)`` with stats ``folded_before``, ``folded_after``, ``flips``,
+    ``splits``, ``rounds``, ``seconds``. Raises RemeshError as :func:`remesh_surface`.
+    """
+    t0 = time.perf_counter()
+    if surface.face_tags is None or len(surface.face_tags) != len(surface.triangles):
+        raise RemeshError("the surface has no face tags")
+    r = _Remesher(surface, projection, math.inf, 1.0, 1.0, 0.0,
+                  set(int(t) for t in frozen_tags), cancel, cad_vertices, repair=True)
+    folded = r.folded_triangles()
+    before = len(folded)
+    done = 0
+    for done in range(1, max(0, int(rounds)) + 1):
+        if not folded:
+            done -= 1
+            break
+        changed = False
+        for t in folded:
+            r.check_cancel()
+            if r.T[t] is None or r.curved_measure(r.T[t], r.tag[t]) > CURVED_FOLD_THRESHOLD:
+                continue
+            changed = r.mend_fold(t) or changed
+        folded = r.folded_triangles()
+        if not changed:
+            break
+    stats = {"folded_before": before, "folded_after": len(folded), "flips": r.count["flip"],
+             "splits": r.count["split"], "rounds": done,
+             "seconds": time.perf_counter() - t0}
+    if before == 0:
+        return surface, stats
+    return r.surface(), stats
+
+
 class _Remesher:
     def __init__(self, surface, projection, h, defl, ang, min_size, frozen, cancel, cad_vertices,
-                 size_points=None):
+                 size_points=None, repair=False):
         sp = np.zeros((0, 4)) if size_points is None else np.asarray(size_points, dtype=float)
         self.size_points = sp.reshape(-1, 4)
         self.proj = projection
@@ -196,6 +280,15 @@ class _Remesher:
                 self.VT[v].add(i)
         self._classify(frozen, cad_vertices)
         self.frozen = frozen
+        self.repair = repair
+        self._mid_cache = {}
+        self.depth = {}  # generation of points made by repair_curved_folds' splits
+        if repair:  # only local mends: no snapping, no size field (splits are never refused
+            self._axis_planes = {}  # for size)
+            self._reference_normals()
+            self.h, self.defl, self.ang, self.min_size, self.user_min_size = h, defl, ang, 0.0, 0.0
+            self.s = [math.inf] * len(self.P)
+            return
         self._axis_planes = self._find_axis_planes(frozen)
         self._snap_axis_planes(frozen)
         self._reference_normals()
@@ -299,6 +392,8 @@ class _Remesher:
 
     def size_at(self, point, tags):
         """The size field's own value at ``point`` (before gradation)."""
+        if self.repair:
+            return math.inf
         k = self.curvature_at(point, tags)
         s = self.h if k <= 0 else min(self.h, math.sqrt(8.0 * self.defl / k), self.ang / k)
         s = max(s, min(self.min_size, self.h))
@@ -429,8 +524,17 @@ class _Remesher:
         return sorted(edges)
 
     def project(self, point, tags):
-        q = [float(c) for c in (self.proj.to_face(point, tags[0]) if len(tags) == 1
-                                else self.proj.to_faces(point, tags))]
+        """``point`` onto its CAD face (one tag) or CAD edge (two). Raises RemeshError for a
+        point of one face whose nearest surface point lies outside the trimmed face: the
+        bounded face's nearest point is then on a CAD edge, and a vertex there that the mesh
+        treats as inside the face makes a flat fin triangle (three corners on one CAD edge)."""
+        if len(tags) == 1:
+            q, inside = self.proj._to_face(point, tags[0])
+            if not inside:
+                raise RemeshError("the point projects outside its face")
+            q = [float(c) for c in q]
+        else:
+            q = [float(c) for c in self.proj.to_faces(point, tags)]
         for tag in tags:
             axis = self.axis_plane(tag)
             if axis is not None:
@@ -488,6 +592,109 @@ class _Remesher:
     def check_cancel(self):
         if self.cancel is not None and self.cancel():
             raise MeshingCancelled("cancelled: no mesh was made")
+
+    # ---- curved (tet10) triangles ----------------------------------------------------------
+
+    def cad_midpoint(self, a, b):
+        """The CAD point a tet10 mid-node of edge (a, b) goes to (as the pipeline places it:
+        onto the face of its triangles, or onto the CAD edge of their two faces)."""
+        key = (a, b) if a < b else (b, a)
+        m = self._mid_cache.get(key)
+        if m is None:
+            mid = tuple(0.5 * (x + y) for x, y in zip(self.P[a], self.P[b]))
+            tags = tuple(sorted({self.tag[t] for t in self.edge_tris(a, b)}))
+            try:
+                m = tuple(float(c) for c in (self.proj.to_face(mid, tags[0]) if len(tags) == 1
+                                             else self.proj.to_faces(mid, tags)))
+            except Exception:
+                m = mid
+            self._mid_cache[key] = m
+        return m
+
+    def curved_measure(self, tri, tag, mids=None):
+        """Smallest area element of the 6-node triangle over the flat one's (1 when flat; <= 0
+        where it folds), at the corners, edge midpoints and centroid. ``mids`` overrides the
+        CAD midpoints of its edges (a, b), (b, c), (c, a)."""
+        x = np.array([self.P[v] for v in tri] +
+                     (list(mids) if mids is not None else
+                      [self.cad_midpoint(tri[i], tri[(i + 1) % 3]) for i in range(3)]))
+        return _curved_triangle_measure(x)
+
+    def folded_triangles(self):
+        return [t for t, tri in enumerate(self.T)
+                if tri is not None and self.tag[t] not in self.frozen and
+                self.curved_measure(tri, self.tag[t]) <= CURVED_FOLD_THRESHOLD]
+
+    def mend_fold(self, t):
+        """One local change that makes folded triangle ``t`` better (see repair_curved_folds)."""
+        tri, tag = self.T[t], self.tag[t]
+        # a flip inside the face, if both new triangles beat the folded one
+        for i in range(3):
+            a, b = tri[i], tri[(i + 1) % 3]
+            ts = sorted(self.edge_tris(a, b))
+            if len(ts) != 2 or self.tag[ts[0]] != self.tag[ts[1]]:
+                continue
+            x, y, c = self._rotate_to(self.T[ts[0]], a, b)
+            _, _, d = self._rotate_to(self.T[ts[1]], a, b)
+            if c == d or d in self.neighbours(c):
+                continue
+            # the new edge (c, d) runs inside the face: its mid-node goes onto that face
+            mid = tuple(0.5 * (p + q) for p, q in zip(self.P[c], self.P[d]))
+            try:
+                m_cd = tuple(float(k) for k in self.proj.to_face(mid, tag))
+            except Exception:
+                continue
+            q1 = self.curved_measure((x, d, c), tag,
+                                     (self.cad_midpoint(x, d), m_cd, self.cad_midpoint(c, x)))
+            q2 = self.curved_measure((d, y, c), tag,
+                                     (self.cad_midpoint(d, y), self.cad_midpoint(y, c), m_cd))
+            if min(q1, q2) > CURVED_FOLD_THRESHOLD and self.flip(a, b, ts, ear=True):
+                return True
+        # else split its longest edge at its CAD point (longest-edge bisection: a needle
+        # across a narrow fillet folds when its length squared exceeds about 2 R w, so halving
+        # the strip's long edges mends it), if that makes the worst of the triangles better;
+        # at most MAX_FOLD_SPLIT_DEPTH generations of new points (near a cusp, halving would go
+        # on for ever)
+        order = sorted(range(3), key=lambda i: (-_dist(self.P[tri[i]], self.P[tri[(i + 1) % 3]]),
+                                                i))
+        for i in order:
+            a, b = tri[i], tri[(i + 1) % 3]
+            ts = sorted(self.edge_tris(a, b))
+            if len(ts) != 2 or max(self.depth.get(a, 0), self.depth.get(b, 0)) >= \
+                    MAX_FOLD_SPLIT_DEPTH:
+                continue
+            if self.split(a, b, ts):
+                self.depth[len(self.P) - 1] = max(self.depth.get(a, 0), self.depth.get(b, 0)) + 1
+                return True
+            break  # only the longest edge: bisecting a shorter one makes worse shapes
+        return False
+
+    def _split_measure(self, a, b, ts):
+        """The smallest curved measure of the four triangles split(a, b, ts) would make."""
+        tags = tuple(sorted({self.tag[t] for t in ts}))
+        mid = tuple(0.5 * (x + y) for x, y in zip(self.P[a], self.P[b]))
+        try:
+            m = self.project(mid, tags)
+            halves = {}
+            for end in (a, b):
+                h = tuple(0.5 * (x + y) for x, y in zip(self.P[end], m))
+                halves[end] = tuple(float(k) for k in (self.proj.to_face(h, tags[0])
+                                                       if len(tags) == 1 else
+                                                       self.proj.to_faces(h, tags)))
+            worst = math.inf
+            for t in ts:
+                x, y, z = self._rotate_to(self.T[t], a, b)
+                tag = self.tag[t]
+                c = tuple(0.5 * (p + q) for p, q in zip(m, self.P[z]))
+                m_z = tuple(float(k) for k in self.proj.to_face(c, tag))
+                for tri, mids in (((x, m, z), (halves[x], m_z, self.cad_midpoint(z, x))),
+                                  ((m, y, z), (halves[y], self.cad_midpoint(y, z), m_z))):
+                    pts = np.array([self.P[v] if isinstance(v, int) else v for v in tri] +
+                                   list(mids))
+                    worst = min(worst, _curved_triangle_measure(pts))
+            return worst
+        except Exception:
+            return -math.inf
 
     # ---- edits ---------------------------------------------------------------------------
 

@@ -75,14 +75,22 @@ def test_projected_points_are_found_by_get_nodes_by_face(fc, kind):
     raw = perturbed_points_near(face, 40, 0.3, seed=tag)
     # the raw points are 0.3 mm off: getNodesByFace finds none of them
     assert nodes_found(fc, raw, face) == set()
-    projected = [proj(p, tag) for p in raw]
+    projected = [proj.to_face(p, tag) for p in raw]
     for q in projected:
         assert proj.distance_to_face(q, tag) < proj.face_tolerance(tag)
     assert nodes_found(fc, projected, face) == set(range(1, len(projected) + 1))
     # idempotent: a projected point stays where it is
     for q in projected:
-        again = proj(q, tag)
+        again = proj.to_face(q, tag)
         assert math.dist(again, q) <= 1e-9
+    # the core's hook gives the same points where the surface's nearest point is inside the
+    # trimmed face, and refuses (non-finite) the others
+    for p, q in zip(raw, projected):
+        h = proj(p, tag)
+        if all(math.isfinite(c) for c in h):
+            assert h == q
+        else:
+            assert all(math.isnan(c) for c in h)
 
 
 def test_points_outside_the_trimmed_face_go_to_its_boundary(fc):
@@ -95,9 +103,13 @@ def test_points_outside_the_trimmed_face_go_to_its_boundary(fc):
     proj = CadProjection(shape)
     top = [k for k in face_index(shape, "Plane") if abs(shape.Faces[k].CenterOfMass.z - 8) < 1e-9]
     assert len(top) == 1
-    q = proj((33.0, 20.0, 9.0), top[0])  # above the hole, 3 mm from its axis
+    q = proj.to_face((33.0, 20.0, 9.0), top[0])  # above the hole, 3 mm from its axis
     assert proj.distance_to_face(q, top[0]) < proj.face_tolerance(top[0])
     assert abs(math.hypot(q[0] - 30, q[1] - 20) - 10) < 1e-9 and abs(q[2] - 8) < 1e-12
+    # the core's hook refuses such a point (a mesh vertex inside the face put onto its edge
+    # would make a flat fin triangle there), and takes one over the face's material
+    assert all(math.isnan(c) for c in proj((33.0, 20.0, 9.0), top[0]))
+    assert proj((45.0, 20.0, 9.0), top[0]) == (45.0, 20.0, 8.0)
 
 
 def test_point_between_two_faces_goes_onto_their_common_edge(fc):

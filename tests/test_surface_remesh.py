@@ -199,3 +199,54 @@ def test_inverted_tet10_is_found_and_refinement_points_sit_on_it():
     assert np.allclose(sp[0, :3], corners.mean(axis=0) + [10, 0, 0])
     assert np.isclose(sp[0, 3], 0.5 * 2 * math.sqrt(2))
     assert np.isclose(mesh_pipeline.refinement_points(mesh, bad, min_size=5.0)[0, 3], 5.0)
+
+
+def filleted_disk(fc, radius=40.0, fillet=1.0):
+    """A cylinder with a narrow fillet on its top edge: OCCT tessellates the fillet in a strip
+    of needles whose curved tet10 versions fold."""
+    _, Part, _ = fc
+    body = Part.makeCylinder(radius, 10)
+    edge = [e for e in body.Edges if type(e.Curve).__name__ == "Circle" and e.BoundBox.ZMin > 9]
+    return body.makeFillet(fillet, edge)
+
+
+def test_curved_folds_are_mended_locally_and_stay_on_the_cad(fc):
+    from FemBspTet.cad_projection import CadProjection
+    from FemBspTet.surface_remesh import repair_curved_folds
+
+    shape = placed(fc, filleted_disk(fc))
+    deflection = cad_tessellation.default_linear_deflection(shape, None)
+    surf = cad_tessellation.tessellate_shape(shape, deflection)[0]
+    proj = CadProjection(shape)
+    out, stats = repair_curved_folds(surf, proj)
+    print(stats)
+    assert stats["folded_before"] > 0
+    assert stats["folded_after"] < stats["folded_before"] / 2
+    core.check_surface(out)  # closed, oriented, no self-intersection (exact)
+    # the tessellation's vertices are all kept where they were; new ones are on their faces
+    old = {tuple(p) for p in surf.points.tolist()}
+    assert old <= {tuple(p) for p in out.points.tolist()}
+    tags = vertex_tags(out)
+    new = [v for v, p in enumerate(out.points.tolist()) if tuple(p) not in old]
+    assert len(new) == stats["splits"]
+    for v in new:
+        for t in tags[v]:
+            assert proj.distance_to_face(out.points[v], t) < proj.face_tolerance(t) + 1e-9
+    # only local changes: most of the tessellation's triangles are still there
+    kept = {tuple(sorted(map(tuple, surf.points[t].tolist()))) for t in surf.triangles}
+    now = {tuple(sorted(map(tuple, out.points[t].tolist()))) for t in out.triangles}
+    assert len(kept & now) >= len(surf.triangles) - 4 * (stats["splits"] + stats["flips"])
+    assert abs(cad_tessellation.signed_volume(out.points, out.triangles) -
+               cad_tessellation.signed_volume(surf.points, surf.triangles)) < \
+        1e-3 * shape.Volume
+
+
+def test_surface_without_folds_is_returned_unchanged(fc):
+    from FemBspTet.cad_projection import CadProjection
+    from FemBspTet.surface_remesh import repair_curved_folds
+
+    _, Part, _ = fc
+    shape = placed(fc, Part.makeBox(10, 20, 30))
+    surf = cad_tessellation.tessellate_shape(shape, 0.1)[0]
+    out, stats = repair_curved_folds(surf, CadProjection(shape))
+    assert out is surf and stats["folded_before"] == 0 and stats["splits"] == 0
