@@ -160,6 +160,22 @@ def tessellate_file(path, size=None, linear_deflection=None, angular_deflection=
     file FreeCAD cannot read (garbage, truncated), a file without shapes or without a solid,
     and for every problem :func:`tessellate_shape` reports.
     """
+    if size is not None:
+        size = _positive_float(size, "size")
+    if linear_deflection is not None:
+        linear_deflection = _positive_float(linear_deflection, "linear_deflection")
+    shape = read_cad_shape(path)
+    path = os.fspath(path)
+    if linear_deflection is None:
+        linear_deflection = default_linear_deflection(shape, size)
+    return tessellate_shape(shape, linear_deflection, angular_deflection, False, source=path)
+
+
+def read_cad_shape(path):
+    """The ``Part.Shape`` of a CAD file (``.step/.stp``, ``.brep/.brp``, ``.iges/.igs``).
+
+    Raises InputError (``where`` = the path) for a missing file, an unsupported extension, a
+    file FreeCAD cannot read and a file without shapes."""
     from .freecad_env import import_freecad
 
     path = os.fspath(path)
@@ -174,10 +190,6 @@ def tessellate_file(path, size=None, linear_deflection=None, angular_deflection=
         raise InputError("file not found", where=where)
     if not os.path.isfile(path):
         raise InputError("not a regular file", where=where)
-    if size is not None:
-        size = _positive_float(size, "size")
-    if linear_deflection is not None:
-        linear_deflection = _positive_float(linear_deflection, "linear_deflection")
 
     import_freecad()
     import Part
@@ -191,10 +203,7 @@ def tessellate_file(path, size=None, linear_deflection=None, angular_deflection=
     if shape.isNull():
         raise InputError("the %s file contains no shape (empty or no geometry FreeCAD can use)"
                          % fmt, where=where)
-
-    if linear_deflection is None:
-        linear_deflection = default_linear_deflection(shape, size)
-    return tessellate_shape(shape, linear_deflection, angular_deflection, False, source=path)
+    return shape
 
 
 def default_linear_deflection(shape, size=None):

@@ -168,11 +168,48 @@ def _write_intersections(path, exc):
           f"{path} (face tags = triangle indices)", file=sys.stderr)
 
 
+def _mesh_on_cad(args, progress):
+    """``mesh --on-cad``: the FreeCAD mesher's pipeline (mesh_pipeline.mesh_cad_shape) on a CAD
+    file: boundary Steiner points and tet10 mid-nodes on the CAD faces. Returns (mesh, stats,
+    notes)."""
+    unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
+                                            ("--surface-points", args.surface_points),
+                                            ("--steiner-effort", args.steiner_effort),
+                                            ("--reorient", args.reorient or None),
+                                            ("--write-intersections", args.write_intersections))
+                   if value is not None]
+    if unsupported:
+        raise InputError("--on-cad does not take " + ", ".join(unsupported) + " (the FreeCAD "
+                         "mesher's pipeline has no such parameter); drop it or --on-cad")
+    if _ext(args.input) not in CAD_EXTENSIONS:
+        raise InputError("--on-cad needs a CAD file (" + ", ".join(CAD_EXTENSIONS) + ")",
+                         where=args.input)
+    from .cad_tessellation import read_cad_shape
+    from .mesh_pipeline import MeshParameters, mesh_cad_shape
+
+    shape = read_cad_shape(args.input)
+    params = MeshParameters(max_size=args.size or 0.0, min_size=args.min_size or 0.0,
+                            order=args.order, quality_bound=args.radius_edge or 0.0,
+                            allow_boundary_steiner=args.allow_boundary_steiner,
+                            compare_tetgen=False)
+    result = mesh_cad_shape(shape, params, progress=lambda stage, fraction: progress(stage),
+                            source=os.path.basename(args.input))
+    return result.mesh, dict(result.stats), list(result.notes)
+
+
 def _cmd_mesh(args):
     progress = Progress(enabled=not args.quiet)
     t0 = time.perf_counter()
     if not hasattr(args, "max_memory_bytes"):
         _check_mesh_args(args)
+    if getattr(args, "on_cad", False):
+        progress("reading the CAD file")
+        try:
+            mesh, stats, notes = _mesh_on_cad(args, progress)
+        finally:
+            progress.finish()
+        stats["notes"] = notes
+        return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None)
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
     from . import core
@@ -199,6 +236,10 @@ def _cmd_mesh(args):
         raise
     finally:
         progress.finish()
+    return _finish_mesh(args, progress, t0, mesh, stats, surfaces)
+
+
+def _finish_mesh(args, progress, t0, mesh, stats, surfaces):
     progress("writing")
     for out in args.output:
         write_output(out, mesh)
@@ -214,6 +255,10 @@ def _cmd_mesh(args):
     if not args.quiet:
         print(json.dumps({k: stats.get(k) for k in STATS_KEYS}, indent=1))
     if args.compare_tetgen:
+        if surfaces is None:
+            from .cad_tessellation import tessellate_file
+
+            surfaces = tessellate_file(args.input, size=args.size)
         print(_tetgen_table(surfaces, stats))
     return 0
 
@@ -390,6 +435,11 @@ def build_parser():
                    help="work (exact orientation tests, cavity growth) the core may spend removing "
                         "one interior Steiner point (default 1000000; 0: no bound, fewer Steiner "
                         "points, possibly much slower)")
+    m.add_argument("--on-cad", action="store_true",
+                   help="CAD input: mesh as the FreeCAD mesher does (needs FreeCAD): boundary "
+                        "points the refinement adds and tet10 mid-nodes go onto the CAD faces and "
+                        "edges (OpenCASCADE), so the mesh follows the curved surface; without it "
+                        "they stay on the tessellation's flat triangles")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.add_argument("--reorient", action="store_true",

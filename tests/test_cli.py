@@ -255,3 +255,64 @@ def test_mesh_steiner_effort_bounds_the_interior_removal(cli, tmp_path):
     r = run(cli, "mesh", joint, "-o", tmp_path / "x.vtu", "--steiner-effort", "-3")
     assert r.returncode == 2 and "steiner-effort" in r.stderr
     assert not (tmp_path / "x.vtu").exists()
+
+
+def _boundary_nodes_off_cad(mesh, shape):
+    """Largest distance from a boundary node (corners and tet10 mid-nodes of boundary faces) to
+    the CAD shape's faces."""
+    import numpy as np
+
+    import Part
+    from FemBspTet.mesh_pipeline import boundary_faces_of, boundary_midnodes
+
+    faces = boundary_faces_of(mesh.tets[:, :4])
+    nodes = set(faces.reshape(-1).tolist())
+    if mesh.tets.shape[1] == 10:
+        nodes |= set(boundary_midnodes(mesh, faces).reshape(-1).tolist())
+    import FreeCAD
+
+    shell = Part.Compound(shape.Faces)
+    worst = 0.0
+    for n in sorted(nodes):
+        p = mesh.points[n]
+        worst = max(worst, shell.distToShape(Part.Vertex(FreeCAD.Vector(*map(float, p))))[0])
+    return worst
+
+
+def test_mesh_on_cad_puts_tet10_mid_nodes_on_the_cad(cli, tmp_path):
+    """``--on-cad``: the FreeCAD mesher's pipeline from the command line; every boundary node of
+    the tet10 mesh lies on the CAD (the plain run leaves mid-nodes on the chords of the
+    cylinder, a chord sag away)."""
+    from FemBspTet.freecad_env import freecad_available, import_freecad
+
+    if not freecad_available():
+        pytest.skip("FreeCAD is not installed")
+    import_freecad()
+    import Part
+
+    from FemBspTet.volume_io import read_tet_mesh
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    cad = os.path.join(root, "tests", "data", "cad", "red_cube_blue_cylinder.step")
+    shape = Part.read(cad)
+    off = {}
+    for flag in ("--on-cad", None):
+        out = tmp_path / ("on.vtu" if flag else "plain.vtu")
+        args = ["mesh", cad, "-o", out, "--order", "2", "--quiet"] + ([flag] if flag else [])
+        r = run(cli, *args)
+        assert r.returncode == 0, r.stderr
+        mesh = read_tet_mesh(str(out))
+        assert mesh.tets.shape[1] == 10
+        off[flag] = _boundary_nodes_off_cad(mesh, shape)
+    assert off["--on-cad"] < 1e-6
+    assert off[None] > 1e-3
+
+
+def test_mesh_on_cad_refuses_a_surface_file_and_core_only_options(cli, tmp_path):
+    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "x.vtu", "--on-cad")
+    assert r.returncode == 2 and "--on-cad needs a CAD file" in r.stderr
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    cad = os.path.join(root, "tests", "data", "cad", "red_cube_blue_cylinder.step")
+    r = run(cli, "mesh", cad, "-o", tmp_path / "x.vtu", "--on-cad", "--reorient")
+    assert r.returncode == 2 and "--reorient" in r.stderr
+    assert not (tmp_path / "x.vtu").exists()
