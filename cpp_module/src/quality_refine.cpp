@@ -484,6 +484,31 @@ class Refiner {
               done = true;
             }
           }
+          // Small lifts: straight up from the face's plane by 1, 3 or 7 times the apex's own
+          // height (over a long needle face even a quarter of a regular tet's height moves the
+          // apex too far for the tets around it).
+          const double height = (D.x - fr.centroid.x) * fr.normal.x + (D.y - fr.centroid.y) * fr.normal.y +
+                                (D.z - fr.centroid.z) * fr.normal.z;
+          for (double k : {1.0, 3.0, 7.0}) {
+            if (done || !(height > 0)) break;
+            const Vec3 target{D.x + k * height * fr.normal.x, D.y + k * height * fr.normal.y,
+                              D.z + k * height * fr.normal.z};
+            auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+              int bad_after = 0;
+              double w = 180;
+              for (std::size_t i = 0; i < moved.size(); ++i) {
+                const auto& c4 = moved[i];
+                w = std::min(w, tet_min_dihedral_deg(c4[0], c4[1], c4[2], c4[3]));
+                bad_after += !curved_ok(m_.tet(ball[i]), c4);
+              }
+              return w >= floor_deg && bad_after < bad_before;
+            };
+            if (m_.relocate_point_if(d, target, accept)) {
+              ++st_.curving_lifts;
+              ++lifted;
+              done = true;
+            }
+          }
         }
         // Else a new interior point above each face of the tet, Bowyer-Watson, accepted when its
         // new tets are all valid curved elements of at least 1 degree.
