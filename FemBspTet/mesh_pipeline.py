@@ -365,9 +365,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
             report("bending interior edges of curved tet10 elements", 0.88)
             bad, bent = bend_interior_edges(mesh, midnodes, bad, cancel=check_cancel)
             fold_stats["bent_interior_midnodes"] = int(len(bent))
-            if len(bent):
-                moved = np.union1d(moved, bent)
-                bad = elements_inverted_by_projection(mesh, moved)
+            if len(bent):  # (moved stays the projected boundary nodes, for the stats)
+                bad = elements_inverted_by_projection(mesh, np.union1d(moved, bent))
         if fold_stats:
             stats = dict(stats)
             stats["curved_repair"] = fold_stats
