@@ -457,11 +457,7 @@ def remesh_cad_surfaces(surfaces, projection, size, params, deflection, cancel=N
     from .errors import InputError
     from .surface_remesh import RemeshError, remesh_surface
 
-    counts = {}
-    for surf in surfaces:
-        for tag in set(surf.face_tags.tolist()):
-            counts[tag] = counts.get(tag, 0) + 1
-    frozen = {tag for tag, c in counts.items() if c > 1}
+    frozen = shared_face_tags(surfaces)
     out, notes, total = [], [], {}
     for i, surf in enumerate(surfaces):
         where = "solid %d" % (i + 1) if len(surfaces) > 1 else "the solid"
@@ -736,27 +732,12 @@ def tet10_jacobians(points, tets):
     """Jacobian determinants of 10-node tets at their 10 nodes and the centroid: (m, 11).
 
     Shape functions in barycentric coordinates: corner ``L_i (2 L_i - 1)``, mid-node
-    ``4 L_i L_j``; for straight edges every value equals ``det[b - a, c - a, d - a]``.
+    ``4 L_i L_j``; for straight edges every value equals ``det[b - a, c - a, d - a]``
+    (:func:`FemBspTet.curved_untangle.jacobians`).
     """
-    x = points[tets]  # (m, 10, 3)
-    edges = _TET10_EDGES
-    samples = [np.eye(4)[i] for i in range(4)]
-    samples += [0.5 * (np.eye(4)[i] + np.eye(4)[j]) for i, j in edges]
-    samples.append(np.full(4, 0.25))
-    out = np.empty((len(tets), len(samples)))
-    for s, lam in enumerate(samples):
-        grads = []
-        for i in range(4):  # dX/dL_i
-            g = (4.0 * lam[i] - 1.0) * x[:, i]
-            for e, (a, b) in enumerate(edges):
-                if a == i:
-                    g = g + 4.0 * lam[b] * x[:, 4 + e]
-                elif b == i:
-                    g = g + 4.0 * lam[a] * x[:, 4 + e]
-            grads.append(g)
-        j1, j2, j3 = grads[1] - grads[0], grads[2] - grads[0], grads[3] - grads[0]
-        out[:, s] = np.einsum("ij,ij->i", np.cross(j1, j2), j3)
-    return out
+    from .curved_untangle import jacobians
+
+    return jacobians(points[tets])
 
 
 #: With RemeshSurface and tet10: how many times the surface is remeshed finer around tets that

@@ -282,6 +282,7 @@ class _Remesher:
         self.frozen = frozen
         self.repair = repair
         self._mid_cache = {}
+        self._measure_cache = {}
         self.depth = {}  # generation of points made by repair_curved_folds' splits
         if repair:  # only local mends: no snapping, no size field (splits are never refused
             self._axis_planes = {}  # for size)
@@ -615,10 +616,17 @@ class _Remesher:
         """Smallest area element of the 6-node triangle over the flat one's (1 when flat; <= 0
         where it folds), at the corners, edge midpoints and centroid. ``mids`` overrides the
         CAD midpoints of its edges (a, b), (b, c), (c, a)."""
-        x = np.array([self.P[v] for v in tri] +
-                     (list(mids) if mids is not None else
-                      [self.cad_midpoint(tri[i], tri[(i + 1) % 3]) for i in range(3)]))
-        return _curved_triangle_measure(x)
+        if mids is not None:
+            return _curved_triangle_measure(np.array([self.P[v] for v in tri] + list(mids)))
+        key = (tuple(tri), tag)  # vertices never move in repair mode: a triangle's value stays
+        value = self._measure_cache.get(key)
+        if value is None:
+            x = np.array([self.P[v] for v in tri] +
+                         [self.cad_midpoint(tri[i], tri[(i + 1) % 3]) for i in range(3)])
+            value = _curved_triangle_measure(x)
+            if self.repair:
+                self._measure_cache[key] = value
+        return value
 
     def folded_triangles(self):
         return [t for t, tri in enumerate(self.T)
@@ -668,33 +676,6 @@ class _Remesher:
                 return True
             break  # only the longest edge: bisecting a shorter one makes worse shapes
         return False
-
-    def _split_measure(self, a, b, ts):
-        """The smallest curved measure of the four triangles split(a, b, ts) would make."""
-        tags = tuple(sorted({self.tag[t] for t in ts}))
-        mid = tuple(0.5 * (x + y) for x, y in zip(self.P[a], self.P[b]))
-        try:
-            m = self.project(mid, tags)
-            halves = {}
-            for end in (a, b):
-                h = tuple(0.5 * (x + y) for x, y in zip(self.P[end], m))
-                halves[end] = tuple(float(k) for k in (self.proj.to_face(h, tags[0])
-                                                       if len(tags) == 1 else
-                                                       self.proj.to_faces(h, tags)))
-            worst = math.inf
-            for t in ts:
-                x, y, z = self._rotate_to(self.T[t], a, b)
-                tag = self.tag[t]
-                c = tuple(0.5 * (p + q) for p, q in zip(m, self.P[z]))
-                m_z = tuple(float(k) for k in self.proj.to_face(c, tag))
-                for tri, mids in (((x, m, z), (halves[x], m_z, self.cad_midpoint(z, x))),
-                                  ((m, y, z), (halves[y], self.cad_midpoint(y, z), m_z))):
-                    pts = np.array([self.P[v] if isinstance(v, int) else v for v in tri] +
-                                   list(mids))
-                    worst = min(worst, _curved_triangle_measure(pts))
-            return worst
-        except Exception:
-            return -math.inf
 
     # ---- edits ---------------------------------------------------------------------------
 

@@ -463,50 +463,39 @@ class Refiner {
             worst_before = std::min(worst_before, m_.tet_quality(s2));
           }
           const double floor_deg = std::min(1.0, worst_before);
-          for (int c = 0; c < 10 && !done; ++c) {
-            const double f = std::array<double, 5>{1.0, 0.75, 0.5, 0.35, 0.25}[static_cast<std::size_t>(c / 2)];
-            const double lambda = c % 2 == 0 ? 1.0 : 0.5;  // all the way, or half way from the apex
+          // Targets in order: towards the apex of a regular tet over the face at 1, 0.75, 0.5,
+          // 0.35 and 0.25 of its height, all the way or half way; then small lifts straight up
+          // from the face's plane by 1, 3 or 7 times the apex's own height (over a long needle
+          // face even a quarter of a regular tet's height moves the apex too far for the tets
+          // around it).
+          std::vector<Vec3> targets;
+          for (double f : {1.0, 0.75, 0.5, 0.35, 0.25}) {
             const Vec3 full = fr.apex(f);
-            const Vec3 target{D.x + lambda * (full.x - D.x), D.y + lambda * (full.y - D.y), D.z + lambda * (full.z - D.z)};
-            auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
-              int bad_after = 0;
-              double w = 180;
-              for (std::size_t i = 0; i < moved.size(); ++i) {
-                const auto& c4 = moved[i];
-                w = std::min(w, tet_min_dihedral_deg(c4[0], c4[1], c4[2], c4[3]));
-                bad_after += !curved_ok(m_.tet(ball[i]), c4);
-              }
-              return w >= floor_deg && bad_after < bad_before;
-            };
-            if (m_.relocate_point_if(d, target, accept)) {
-              ++st_.curving_lifts;
-              ++lifted;
-              done = true;
-            }
+            for (double lambda : {1.0, 0.5})
+              targets.push_back({D.x + lambda * (full.x - D.x), D.y + lambda * (full.y - D.y), D.z + lambda * (full.z - D.z)});
           }
-          // Small lifts: straight up from the face's plane by 1, 3 or 7 times the apex's own
-          // height (over a long needle face even a quarter of a regular tet's height moves the
-          // apex too far for the tets around it).
           const double height = (D.x - fr.centroid.x) * fr.normal.x + (D.y - fr.centroid.y) * fr.normal.y +
                                 (D.z - fr.centroid.z) * fr.normal.z;
-          for (double k : {1.0, 3.0, 7.0}) {
-            if (done || !(height > 0)) break;
-            const Vec3 target{D.x + k * height * fr.normal.x, D.y + k * height * fr.normal.y,
-                              D.z + k * height * fr.normal.z};
-            auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
-              int bad_after = 0;
-              double w = 180;
-              for (std::size_t i = 0; i < moved.size(); ++i) {
-                const auto& c4 = moved[i];
-                w = std::min(w, tet_min_dihedral_deg(c4[0], c4[1], c4[2], c4[3]));
-                bad_after += !curved_ok(m_.tet(ball[i]), c4);
-              }
-              return w >= floor_deg && bad_after < bad_before;
-            };
+          if (height > 0)
+            for (double times : {1.0, 3.0, 7.0})
+              targets.push_back({D.x + times * height * fr.normal.x, D.y + times * height * fr.normal.y,
+                                 D.z + times * height * fr.normal.z});
+          auto accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+            int bad_after = 0;
+            double w = 180;
+            for (std::size_t i = 0; i < moved.size(); ++i) {
+              const auto& c4 = moved[i];
+              w = std::min(w, tet_min_dihedral_deg(c4[0], c4[1], c4[2], c4[3]));
+              bad_after += !curved_ok(m_.tet(ball[i]), c4);
+            }
+            return w >= floor_deg && bad_after < bad_before;
+          };
+          for (const Vec3& target : targets) {
             if (m_.relocate_point_if(d, target, accept)) {
               ++st_.curving_lifts;
               ++lifted;
               done = true;
+              break;
             }
           }
         }
