@@ -320,7 +320,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     # tet10: with RemeshSurface, rounds of local refinement; without, one more attempt on the
     # tessellation with its folding curved triangles mended (repair_curved_folds_of), kept only
     # if it inverts fewer elements (it helps some parts and not others: measured, session 10)
-    rounds = (LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else 1) if params.order == 2 else 0
+    rounds = (LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else CURVED_REPAIR_ROUNDS) \
+        if params.order == 2 else 0
 
     def core_progress(stage, fraction):
         report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
@@ -337,12 +338,17 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
                 tessellation, projection, element_size, params, deflection, cancel=check_cancel,
                 size_points=size_points)
         fold_stats = {}
-        if attempt == 1 and not params.remesh_surface:
-            report("mending tessellation triangles whose curved tet10 faces would fold", 0.03)
-            surfaces, fold_stats = repair_curved_folds_of(tessellation, projection,
-                                                          cancel=check_cancel)
-            if fold_stats["folded_after"] >= fold_stats["folded_before"]:
-                break  # nothing mended: the first attempt stands
+        if attempt >= 1 and not params.remesh_surface:
+            report("mending tessellation triangles around the curved tet10s that inverted "
+                   "(round %d)" % attempt, 0.03)
+            base, base_mesh, base_bad = best[1], best[4], best[-1]
+            surfaces, fold_stats = repair_curved_folds_of(base, projection, cancel=check_cancel)
+            corners = base_mesh.points[base_mesh.tets[base_bad, :4]].reshape(-1, 3)
+            surfaces, near_stats = refine_around_points_of(surfaces, projection, corners,
+                                                           cancel=check_cancel)
+            fold_stats.update({"needle_" + k: v for k, v in near_stats.items()})
+            if all(a is b for a, b in zip(surfaces, base)):
+                break  # nothing changed: the best attempt stands
         try:
             mesh, stats = core.tetrahedralize(surfaces, options=options, progress=core_progress,
                                               cancel=cancel)
@@ -515,6 +521,35 @@ def repair_curved_folds_of(surfaces, projection, cancel=None):
             out.append(surf)
             continue
         for k in ("folded_before", "folded_after", "flips", "splits", "seconds"):
+            total[k] += st[k]
+        out.append(new)
+    return out, total
+
+
+def refine_around_points_of(surfaces, projection, points, cancel=None):
+    """Each solid's surface through :func:`FemBspTet.surface_remesh.refine_around_points`
+    (tet10 only): its needle triangles around ``points`` (the corners of elements that curving
+    inverted) split and flipped. A changed surface is used only if it passes the core's exact
+    input check; else the solid keeps its surface. Returns ``(surfaces, stats)``, stats summed
+    over the solids (``region_triangles``, ``splits``, ``flips``, ``seconds``, ``not_used``)."""
+    from . import core
+    from .errors import InputError
+    from .surface_remesh import RemeshError, refine_around_points
+
+    frozen = shared_face_tags(surfaces)
+    out, total = [], {"region_triangles": 0, "splits": 0, "flips": 0, "seconds": 0.0,
+                      "not_used": 0}
+    for surf in surfaces:
+        try:
+            new, st = refine_around_points(surf, projection, points, frozen_tags=frozen,
+                                           cancel=cancel)
+            if new is not surf:
+                core.check_surface(new)
+        except (RemeshError, InputError):
+            total["not_used"] += 1
+            out.append(surf)
+            continue
+        for k in ("region_triangles", "splits", "flips", "seconds"):
             total[k] += st[k]
         out.append(new)
     return out, total
@@ -740,6 +775,9 @@ def tet10_jacobians(points, tets):
     return jacobians(points[tets])
 
 
+#: tet10 without RemeshSurface: how many times the surface around the elements that curving
+#: inverted is mended (folds, needles) and meshed again, while that lowers their number.
+CURVED_REPAIR_ROUNDS = 3
 #: With RemeshSurface and tet10: how many times the surface is remeshed finer around tets that
 #: the curved mid-nodes would invert before the pipeline gives up with the error.
 LOCAL_REFINEMENT_ROUNDS = 3

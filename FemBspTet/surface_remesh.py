@@ -259,6 +259,80 @@ def repair_curved_folds(surface, projection, frozen_tags=(), rounds=FOLD_REPAIR_
     return r.surface(), stats
 
 
+#: :func:`refine_around_points`: triangles of lower quality (:func:`_quality`) get their longest
+#: edge split.
+NEEDLE_QUALITY = 0.5
+#: :func:`refine_around_points`: passes of splits and flips at most.
+LOCAL_REFINE_PASSES = 6
+
+
+def refine_around_points(surface, projection, points, frozen_tags=(),
+                         passes=LOCAL_REFINE_PASSES, cancel=None, cad_vertices=None):
+    """Make the tessellation's triangles around ``points`` well shaped, leaving the rest alone.
+
+    For tet10 next to curved faces: the elements that stay invalid after curving sit on needle
+    triangles of the CAD tessellation (a long thin triangle of a planar ring beside a small hole,
+    a strip of a narrow fillet), where every tet on them is as thin as the needle is narrow and
+    the chord sag of its curved edges is a large part of that. Triangles with a vertex at one of
+    ``points`` (coordinates; (k, 3)), and the triangles made from them, are treated in passes:
+    each one whose quality is below ``NEEDLE_QUALITY`` gets its longest edge split at that
+    edge's CAD point (on the CAD edge when the edge joins two faces; at most
+    ``MAX_FOLD_SPLIT_DEPTH`` generations of new points), then the region's edges are flipped
+    inside their CAD faces where that makes the worse triangle better (no fold, no crease).
+    Tessellation vertices never move; faces in ``frozen_tags`` are left alone.
+
+    Returns ``(Surface, stats)`` with stats ``region_triangles``, ``splits``, ``flips``,
+    ``passes``, ``seconds``. Raises RemeshError as :func:`remesh_surface`.
+    """
+    t0 = time.perf_counter()
+    if surface.face_tags is None or len(surface.face_tags) != len(surface.triangles):
+        raise RemeshError("the surface has no face tags")
+    r = _Remesher(surface, projection, math.inf, 1.0, 1.0, 0.0,
+                  set(int(t) for t in frozen_tags), cancel, cad_vertices, repair=True)
+    keys = {tuple(p) for p in np.asarray(points, dtype=np.float64).reshape(-1, 3).tolist()}
+    region = {t for v, p in enumerate(r.P) if p in keys for t in r.VT[v]}
+    stats = {"region_triangles": len(region), "splits": 0, "flips": 0, "passes": 0,
+             "seconds": 0.0}
+    if not region:
+        stats["seconds"] = time.perf_counter() - t0
+        return surface, stats
+    splits0, flips0 = r.count["split"], r.count["flip"]
+    for done in range(1, max(0, int(passes)) + 1):
+        r.check_cancel()
+        stats["passes"] = done
+        changed = False
+        for t in sorted((t for t in region if r.tag[t] not in r.frozen),
+                        key=lambda t: (r.tri_quality(r.T[t]), t)):
+            tri = r.T[t]
+            if tri is None or r.tri_quality(tri) >= NEEDLE_QUALITY:
+                continue
+            i = max(range(3), key=lambda i: (_dist(r.P[tri[i]], r.P[tri[(i + 1) % 3]]), -i))
+            a, b = tri[i], tri[(i + 1) % 3]
+            ts = sorted(r.edge_tris(a, b))
+            if len(ts) != 2 or max(r.depth.get(a, 0), r.depth.get(b, 0)) >= \
+                    MAX_FOLD_SPLIT_DEPTH:
+                continue
+            first_new = len(r.T)
+            if r.split(a, b, ts):
+                r.depth[len(r.P) - 1] = max(r.depth.get(a, 0), r.depth.get(b, 0)) + 1
+                # the halves of a region triangle stay in the region (its neighbour's do not)
+                region.update(first_new + k for k, t2 in enumerate(ts) if t2 in region)
+                changed = True
+        for a, b in sorted({(min(x, y), max(x, y)) for t in region if r.T[t] is not None
+                            for x, y in zip(r.T[t], r.T[t][1:] + r.T[t][:1])}):
+            ts = sorted(r.edge_tris(a, b))
+            if len(ts) == 2 and r.tag[ts[0]] == r.tag[ts[1]] and r.flip(a, b, ts):
+                changed = True
+        if not changed:
+            break
+    stats["splits"] = r.count["split"] - splits0
+    stats["flips"] = r.count["flip"] - flips0
+    stats["seconds"] = time.perf_counter() - t0
+    if stats["splits"] == 0 and stats["flips"] == 0:
+        return surface, stats
+    return r.surface(), stats
+
+
 class _Remesher:
     def __init__(self, surface, projection, h, defl, ang, min_size, frozen, cancel, cad_vertices,
                  size_points=None, repair=False):

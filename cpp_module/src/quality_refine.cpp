@@ -447,7 +447,8 @@ class Refiner {
       for (Index t : bad) {
         if (!m_.tet_alive(t) || curved_ok(m_.tet(t), corners(m_.tet(t)))) continue;
         const auto q = m_.tet(t);
-        bool done = false;
+        bool done = reconnect_for_curving(t, curved_ok, corners);
+        if (done) ++lifted;
         for (int k = 0; k < 4 && !done; ++k) {
           const Index d = q[k];
           if (m_.support(d).kind != Support::kInterior) continue;
@@ -534,6 +535,62 @@ class Refiner {
       }
       if (lifted == 0) return;
     }
+  }
+
+  // Tries to make the invalid curved element t valid by changing the connectivity around it: 2-3
+  // flips of its interior faces, 3-2 flips of its interior edges, then collapses of its interior
+  // Steiner corners onto a neighbour. A change is applied when it lowers the number of invalid
+  // curved elements among the tets it replaces and none of its new tets is below min(1 degree,
+  // the worst old tet's) (as the lifts below). The surface never changes. True when one was made.
+  template <class CurvedOk, class Corners>
+  bool reconnect_for_curving(Index t, const CurvedOk& curved_ok, const Corners& corners) {
+    static const int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+    const TetsAccept accept = [&](const std::vector<std::array<Index, 4>>& removed,
+                                  const std::vector<std::array<Index, 4>>& created) {
+      int bad_before = 0;
+      double worst_before = 180;
+      for (const auto& r : removed) {
+        const auto P = corners(r);
+        bad_before += !curved_ok(r, P);
+        worst_before = std::min(worst_before, tet_min_dihedral_deg(P[0], P[1], P[2], P[3]));
+      }
+      const double floor_deg = std::min(1.0, worst_before);
+      int bad_after = 0;
+      for (const auto& c : created) {
+        const auto P = corners(c);
+        if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) < floor_deg) return false;
+        bad_after += !curved_ok(c, P);
+        if (bad_after >= bad_before) return false;
+      }
+      return bad_after < bad_before;
+    };
+    const auto q = m_.tet(t);
+    for (int k = 0; k < 4; ++k)
+      if (m_.flip23(t, k, accept)) {
+        ++st_.flips23;
+        return true;
+      }
+    for (const auto& e : kEdge)
+      if (m_.flip32(q[e[0]], q[e[1]], accept)) {
+        ++st_.flips32;
+        return true;
+      }
+    for (int k = 0; k < 4; ++k) {
+      const Index d = q[k];
+      if (m_.support(d).kind != Support::kInterior) continue;
+      std::vector<Index> nbrs;
+      for (Index s : m_.tets_around_point(d))
+        for (Index w : m_.tet(s))
+          if (w != d) nbrs.push_back(w);
+      std::sort(nbrs.begin(), nbrs.end());
+      nbrs.erase(std::unique(nbrs.begin(), nbrs.end()), nbrs.end());
+      for (Index w : nbrs)
+        if (m_.collapse_edge(d, w, 0.0, kInf, accept)) {
+          ++st_.collapses;
+          return true;
+        }
+    }
+    return false;
   }
 
   // ---- Phase 2: optimization ------------------------------------------------------------------

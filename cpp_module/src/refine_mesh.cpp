@@ -455,7 +455,8 @@ bool RefineMesh::support_allows_collapse(Index from, Index to) const {
   return false;
 }
 
-bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double max_edge2) {
+bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double max_edge2,
+                               const TetsAccept& accept) {
   if (!support_allows_collapse(from, to)) return false;
   if (!edge_exists(from, to)) return false;
   if (support(from).kind != Support::kInterior && edge_kind(from, to) == EdgeKind::kInterior) return false;
@@ -475,6 +476,11 @@ bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double 
     for (Index w : q)
       if (w != to && squared_distance(point(w), target) > max_edge2) return false;
     created.push_back(q);
+  }
+  if (accept) {
+    std::vector<std::array<Index, 4>> removed;
+    for (Index t : ball) removed.push_back(tet(t));
+    if (!accept(removed, created)) return false;
   }
   // Boundary faces around `from`: the ones with `to` vanish, the others move onto `to`.
   std::vector<std::pair<FaceKey, Index>> faces;
@@ -509,7 +515,7 @@ bool RefineMesh::collapse_edge(Index from, Index to, double min_quality, double 
   return true;
 }
 
-bool RefineMesh::flip23(Index t, int opposite_vertex) {
+bool RefineMesh::flip23(Index t, int opposite_vertex, const TetsAccept& accept) {
   if (!tet_alive(t)) return false;
   const auto& q = tet(t);
   const Index a = q[opposite_vertex];
@@ -530,14 +536,15 @@ bool RefineMesh::flip23(Index t, int opposite_vertex) {
   const std::array<std::array<Index, 4>, 3> created = {{{y, x, a, b}, {z, y, a, b}, {x, z, a, b}}};
   const double old_min = std::min(tet_quality(t), tet_quality(other));
   for (const auto& c : created)
-    if (!positive(c) || quality_of(c) <= old_min + kImprovement) return false;
+    if (!positive(c) || (!accept && quality_of(c) <= old_min + kImprovement)) return false;
+  if (accept && !accept({tet(t), tet(other)}, {created.begin(), created.end()})) return false;
   kill_tet(t);
   kill_tet(other);
   for (const auto& c : created) add_tet(c);
   return true;
 }
 
-bool RefineMesh::flip32(Index u, Index v) {
+bool RefineMesh::flip32(Index u, Index v, const TetsAccept& accept) {
   const std::vector<Index> shell = tets_around_edge(u, v);
   if (shell.size() != 3) return false;
   if (edge_kind(u, v) != EdgeKind::kInterior) return false;
@@ -568,7 +575,12 @@ bool RefineMesh::flip32(Index u, Index v) {
   double old_min = 180;
   for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
   for (const auto& c : created)
-    if (!positive(c) || quality_of(c) <= old_min + kImprovement) return false;
+    if (!positive(c) || (!accept && quality_of(c) <= old_min + kImprovement)) return false;
+  if (accept) {
+    std::vector<std::array<Index, 4>> removed;
+    for (Index s : shell) removed.push_back(tet(s));
+    if (!accept(removed, {created.begin(), created.end()})) return false;
+  }
   for (Index s : shell) kill_tet(s);
   for (const auto& c : created) add_tet(c);
   return true;

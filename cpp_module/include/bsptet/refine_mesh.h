@@ -84,6 +84,11 @@ enum class InsertOutcome {
 /// Kind of a mesh edge with respect to the boundary.
 enum class EdgeKind { kInterior, kInFace, kOnInputEdge };
 
+/// Asked by an operation before it is applied, with the tets it would remove and those it would
+/// create (corner indices; every created tet already checked positive); false refuses it.
+using TetsAccept = std::function<bool(const std::vector<std::array<Index, 4>>& removed,
+                                      const std::vector<std::array<Index, 4>>& created)>;
+
 class RefineMesh {
  public:
   /// Builds the editable mesh. Preconditions: `mesh` is a valid linear tet mesh of `surface` (as
@@ -129,13 +134,16 @@ class RefineMesh {
   /// Removes point `from` by moving it onto its neighbour `to` (tets with both are deleted). Only
   /// for points that are not input points, within their support. Applied when every new tet is
   /// positive, its min dihedral is at least min(min_quality, the worst old tet's), and every new
-  /// edge is at most sqrt(max_edge2) long (pass infinity for no limit).
-  bool collapse_edge(Index from, Index to, double min_quality, double max_edge2);
+  /// edge is at most sqrt(max_edge2) long (pass infinity for no limit), and `accept` (if given)
+  /// agrees.
+  bool collapse_edge(Index from, Index to, double min_quality, double max_edge2,
+                     const TetsAccept& accept = {});
   /// 2-3 flip of the interior face of tet t opposite its vertex `opposite` (0..3), applied when
-  /// valid and it raises the smallest min dihedral of the tets involved.
-  bool flip23(Index t, int opposite);
+  /// valid and it raises the smallest min dihedral of the tets involved; with `accept`, when
+  /// valid and `accept` agrees (the angle test is then the caller's).
+  bool flip23(Index t, int opposite, const TetsAccept& accept = {});
   /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23.
-  bool flip32(Index u, Index v);
+  bool flip32(Index u, Index v, const TetsAccept& accept = {});
   /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
   /// tet `start` that never crosses a boundary face (kOutside when it would: p is outside the
   /// solid or on its boundary). The cavity is the tets whose circumsphere contains p (computed in
