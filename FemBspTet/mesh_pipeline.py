@@ -776,8 +776,9 @@ def tet10_jacobians(points, tets):
 
 
 #: tet10 without RemeshSurface: how many times the surface around the elements that curving
-#: inverted is mended (folds, needles) and meshed again, while that lowers their number.
-CURVED_REPAIR_ROUNDS = 3
+#: inverted is mended (folds, needles) and meshed again (each round costs a core run: 3 rounds
+#: took SampleCrankshaft4A past 300 s; one made as1-tu-203 mesh).
+CURVED_REPAIR_ROUNDS = 1
 #: With RemeshSurface and tet10: how many times the surface is remeshed finer around tets that
 #: the curved mid-nodes would invert before the pipeline gives up with the error.
 LOCAL_REFINEMENT_ROUNDS = 3

@@ -274,7 +274,7 @@ def refine_around_points(surface, projection, points, frozen_tags=(),
     triangles of the CAD tessellation (a long thin triangle of a planar ring beside a small hole,
     a strip of a narrow fillet), where every tet on them is as thin as the needle is narrow and
     the chord sag of its curved edges is a large part of that. Triangles with a vertex at one of
-    ``points`` (coordinates; (k, 3)), and the triangles made from them, are treated in passes:
+    ``points`` (coordinates; (k, 3)), and the halves split from them, are treated in passes:
     each one whose quality is below ``NEEDLE_QUALITY`` gets its longest edge split at that
     edge's CAD point (on the CAD edge when the edge joins two faces; at most
     ``MAX_FOLD_SPLIT_DEPTH`` generations of new points), then the region's edges are flipped

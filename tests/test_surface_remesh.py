@@ -250,3 +250,49 @@ def test_surface_without_folds_is_returned_unchanged(fc):
     surf = cad_tessellation.tessellate_shape(shape, 0.1)[0]
     out, stats = repair_curved_folds(surf, CadProjection(shape))
     assert out is surf and stats["folded_before"] == 0 and stats["splits"] == 0
+
+
+def test_needles_around_given_points_are_split_on_the_cad_and_nothing_else_changes(fc):
+    """refine_around_points (the pipeline's tet10 mend around inverted elements): the needle
+    triangles of a plate's planar ring around a small hole get better, new vertices lie on
+    their CAD faces, triangles away from the points are untouched."""
+    from FemBspTet.cad_projection import CadProjection
+    from FemBspTet.surface_remesh import NEEDLE_QUALITY, _quality, refine_around_points
+
+    freecad, Part, _ = fc
+    shape = placed(fc, Part.makeBox(60, 40, 8).cut(
+        Part.makeCylinder(3, 8, freecad.Vector(30, 20, 0))))
+    deflection = cad_tessellation.default_linear_deflection(shape, None)
+    surf = cad_tessellation.tessellate_shape(shape, deflection)[0]
+    proj = CadProjection(shape)
+    q = np.array([_quality(*surf.points[t].tolist()) for t in surf.triangles])
+    worst = np.argsort(q)[:3]
+    assert q[worst].max() < NEEDLE_QUALITY  # the test needs needles to start with
+    points = surf.points[surf.triangles[worst]].reshape(-1, 3)
+    out, stats = refine_around_points(surf, proj, points)
+    print(stats, "worst qualities before", q[worst])
+    assert stats["splits"] > 0
+    core.check_surface(out)
+    old = {tuple(p) for p in surf.points.tolist()}
+    assert old <= {tuple(p) for p in out.points.tolist()}
+    tags = vertex_tags(out)
+    new = [v for v, p in enumerate(out.points.tolist()) if tuple(p) not in old]
+    assert len(new) == stats["splits"]
+    for v in new:
+        for t in tags[v]:
+            assert proj.distance_to_face(out.points[v], t) < proj.face_tolerance(t) + 1e-9
+    # the triangles at the given points are better than the worst of them was
+    keys = {tuple(p) for p in points.tolist()}
+    at = [t for t in out.triangles if any(tuple(p) in keys for p in out.points[t].tolist())]
+    before = [t for t in surf.triangles if any(tuple(p) in keys for p in surf.points[t].tolist())]
+    needles = [sum(_quality(*x.points[t].tolist()) < NEEDLE_QUALITY for t in ts)
+               / len(ts) for x, ts in ((surf, before), (out, at))]
+    print("share of needles at the points: before %.2f, after %.2f" % tuple(needles))
+    assert needles[1] < needles[0]
+    # only local changes: each split or flip replaces at most four of the old triangles
+    kept = {tuple(sorted(map(tuple, surf.points[t].tolist()))) for t in surf.triangles}
+    now = {tuple(sorted(map(tuple, out.points[t].tolist()))) for t in out.triangles}
+    assert len(kept & now) >= len(surf.triangles) - 4 * (stats["splits"] + stats["flips"])
+    assert abs(cad_tessellation.signed_volume(out.points, out.triangles) -
+               cad_tessellation.signed_volume(surf.points, surf.triangles)) < \
+        1e-3 * shape.Volume
