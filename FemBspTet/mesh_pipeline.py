@@ -341,12 +341,19 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         if attempt >= 1 and not params.remesh_surface:
             report("mending tessellation triangles around the curved tet10s that inverted "
                    "(round %d)" % attempt, 0.03)
+            # round 1 mends folded triangles (if any); later rounds, or round 1 without folds,
+            # split the needles around the elements that stayed inverted (separately: on
+            # SampleCrankshaft4A the folds' mend alone gave 34, both at once 85)
             base, base_mesh, base_bad = best[1], best[4], best[-1]
-            surfaces, fold_stats = repair_curved_folds_of(base, projection, cancel=check_cancel)
-            corners = base_mesh.points[base_mesh.tets[base_bad, :4]].reshape(-1, 3)
-            surfaces, near_stats = refine_around_points_of(surfaces, projection, corners,
-                                                           cancel=check_cancel)
-            fold_stats.update({"needle_" + k: v for k, v in near_stats.items()})
+            surfaces = base
+            if attempt == 1:
+                surfaces, fold_stats = repair_curved_folds_of(base, projection,
+                                                              cancel=check_cancel)
+            if all(a is b for a, b in zip(surfaces, base)):
+                corners = base_mesh.points[base_mesh.tets[base_bad, :4]].reshape(-1, 3)
+                surfaces, near_stats = refine_around_points_of(base, projection, corners,
+                                                               cancel=check_cancel)
+                fold_stats.update({"needle_" + k: v for k, v in near_stats.items()})
             if all(a is b for a, b in zip(surfaces, base)):
                 break  # nothing changed: the best attempt stands
         try:
@@ -776,9 +783,9 @@ def tet10_jacobians(points, tets):
 
 
 #: tet10 without RemeshSurface: how many times the surface around the elements that curving
-#: inverted is mended (folds, needles) and meshed again (each round costs a core run: 3 rounds
-#: took SampleCrankshaft4A past 300 s; one made as1-tu-203 mesh).
-CURVED_REPAIR_ROUNDS = 1
+#: inverted is mended (round 1: folded triangles; then needles) and meshed again while that
+#: lowers their number (each round costs a core run).
+CURVED_REPAIR_ROUNDS = 2
 #: With RemeshSurface and tet10: how many times the surface is remeshed finer around tets that
 #: the curved mid-nodes would invert before the pipeline gives up with the error.
 LOCAL_REFINEMENT_ROUNDS = 3
