@@ -317,9 +317,10 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         options[CORE_OPTION_OF["max_size"]] = float(element_size)
     tessellation = surfaces
     size_points = np.zeros((0, 4))
-    # tet10: with RemeshSurface, rounds of local refinement; without, one more attempt on the
-    # tessellation with its folding curved triangles mended (repair_curved_folds_of), kept only
-    # if it inverts fewer elements (it helps some parts and not others: measured, session 10)
+    # tet10: with RemeshSurface, rounds of local refinement; without, CURVED_REPAIR_ROUNDS more
+    # attempts on the best surface so far, its folding curved triangles (repair_curved_folds_of)
+    # or its needles around the inverted elements (refine_around_points_of) mended, each kept
+    # only if it inverts fewer elements (they help some parts and not others: measured)
     rounds = (LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else CURVED_REPAIR_ROUNDS) \
         if params.order == 2 else 0
 
@@ -503,34 +504,48 @@ def shared_face_tags(surfaces):
     return {tag for tag, c in counts.items() if c > 1}
 
 
-def repair_curved_folds_of(surfaces, projection, cancel=None):
-    """Each solid's tessellation through :func:`FemBspTet.surface_remesh.repair_curved_folds`
-    (tet10 only). A repaired surface is used only if it has fewer folded triangles and passes
-    the core's exact input check; else the solid keeps its tessellation. Returns ``(surfaces,
-    stats)``, stats summed over the solids (``folded_before``, ``folded_after``, ``flips``,
-    ``splits``, ``seconds``, ``not_used``)."""
+def _mend_each_surface(surfaces, mend, summed, better=lambda st: True):
+    """``mend(surface, frozen_tags) -> (Surface, stats)`` on each solid's surface. A changed
+    surface is used only if ``better(stats)`` and it passes the core's exact input check; else
+    the solid keeps its surface. Returns ``(surfaces, stats)``: the ``summed`` stats added over
+    the solids whose surface was used, and ``not_used``."""
     from . import core
     from .errors import InputError
-    from .surface_remesh import RemeshError, repair_curved_folds
+    from .surface_remesh import RemeshError
 
     frozen = shared_face_tags(surfaces)
-    out, total = [], {"folded_before": 0, "folded_after": 0, "flips": 0, "splits": 0,
-                      "seconds": 0.0, "not_used": 0}
+    out, total = [], dict({k: 0 for k in summed}, seconds=0.0, not_used=0)
     for surf in surfaces:
         try:
-            new, st = repair_curved_folds(surf, projection, frozen_tags=frozen, cancel=cancel)
+            new, st = mend(surf, frozen)
             if new is not surf:
-                if st["folded_after"] >= st["folded_before"]:
+                if not better(st):
                     raise RemeshError("no better")
                 core.check_surface(new)
         except (RemeshError, InputError):
             total["not_used"] += 1
             out.append(surf)
             continue
-        for k in ("folded_before", "folded_after", "flips", "splits", "seconds"):
+        for k in summed + ("seconds",):
             total[k] += st[k]
         out.append(new)
     return out, total
+
+
+def repair_curved_folds_of(surfaces, projection, cancel=None):
+    """Each solid's tessellation through :func:`FemBspTet.surface_remesh.repair_curved_folds`
+    (tet10 only). A repaired surface is used only if it has fewer folded triangles and passes
+    the core's exact input check; else the solid keeps its tessellation. Returns ``(surfaces,
+    stats)``, stats summed over the solids (``folded_before``, ``folded_after``, ``flips``,
+    ``splits``, ``seconds``, ``not_used``)."""
+    from .surface_remesh import repair_curved_folds
+
+    return _mend_each_surface(
+        surfaces,
+        lambda surf, frozen: repair_curved_folds(surf, projection, frozen_tags=frozen,
+                                                 cancel=cancel),
+        ("folded_before", "folded_after", "flips", "splits"),
+        better=lambda st: st["folded_after"] < st["folded_before"])
 
 
 def refine_around_points_of(surfaces, projection, points, cancel=None):
@@ -539,27 +554,13 @@ def refine_around_points_of(surfaces, projection, points, cancel=None):
     inverted) split and flipped. A changed surface is used only if it passes the core's exact
     input check; else the solid keeps its surface. Returns ``(surfaces, stats)``, stats summed
     over the solids (``region_triangles``, ``splits``, ``flips``, ``seconds``, ``not_used``)."""
-    from . import core
-    from .errors import InputError
-    from .surface_remesh import RemeshError, refine_around_points
+    from .surface_remesh import refine_around_points
 
-    frozen = shared_face_tags(surfaces)
-    out, total = [], {"region_triangles": 0, "splits": 0, "flips": 0, "seconds": 0.0,
-                      "not_used": 0}
-    for surf in surfaces:
-        try:
-            new, st = refine_around_points(surf, projection, points, frozen_tags=frozen,
-                                           cancel=cancel)
-            if new is not surf:
-                core.check_surface(new)
-        except (RemeshError, InputError):
-            total["not_used"] += 1
-            out.append(surf)
-            continue
-        for k in ("region_triangles", "splits", "flips", "seconds"):
-            total[k] += st[k]
-        out.append(new)
-    return out, total
+    return _mend_each_surface(
+        surfaces,
+        lambda surf, frozen: refine_around_points(surf, projection, points, frozen_tags=frozen,
+                                                  cancel=cancel),
+        ("region_triangles", "splits", "flips"))
 
 
 def bend_interior_edges(mesh, midnodes, bad, cancel=None):

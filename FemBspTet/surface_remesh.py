@@ -306,15 +306,9 @@ def refine_around_points(surface, projection, points, frozen_tags=(),
             tri = r.T[t]
             if tri is None or r.tri_quality(tri) >= NEEDLE_QUALITY:
                 continue
-            i = max(range(3), key=lambda i: (_dist(r.P[tri[i]], r.P[tri[(i + 1) % 3]]), -i))
-            a, b = tri[i], tri[(i + 1) % 3]
-            ts = sorted(r.edge_tris(a, b))
-            if len(ts) != 2 or max(r.depth.get(a, 0), r.depth.get(b, 0)) >= \
-                    MAX_FOLD_SPLIT_DEPTH:
-                continue
             first_new = len(r.T)
-            if r.split(a, b, ts):
-                r.depth[len(r.P) - 1] = max(r.depth.get(a, 0), r.depth.get(b, 0)) + 1
+            ts = r.bisect_longest_edge(tri)
+            if ts is not None:
                 # the halves of a region triangle stay in the region (its neighbour's do not)
                 region.update(first_new + k for k, t2 in enumerate(ts) if t2 in region)
                 changed = True
@@ -737,19 +731,27 @@ class _Remesher:
         # the strip's long edges mends it), if that makes the worst of the triangles better;
         # at most MAX_FOLD_SPLIT_DEPTH generations of new points (near a cusp, halving would go
         # on for ever)
-        order = sorted(range(3), key=lambda i: (-_dist(self.P[tri[i]], self.P[tri[(i + 1) % 3]]),
-                                                i))
-        for i in order:
+        return self.bisect_longest_edge(tri, or_next=True) is not None
+
+    def bisect_longest_edge(self, tri, or_next=False):
+        """Split the longest edge of ``tri`` at its CAD point, unless it is not an edge of two
+        triangles or a point on it is already of the MAX_FOLD_SPLIT_DEPTH-th generation (then,
+        with ``or_next``, the next longest such edge). A refused split is not retried on a
+        shorter edge: bisecting a shorter one makes worse shapes. Returns the triangles whose
+        edge was split (their halves are appended to ``self.T`` in that order) or None."""
+        for i in sorted(range(3), key=lambda i: (-_dist(self.P[tri[i]],
+                                                         self.P[tri[(i + 1) % 3]]), i)):
             a, b = tri[i], tri[(i + 1) % 3]
             ts = sorted(self.edge_tris(a, b))
-            if len(ts) != 2 or max(self.depth.get(a, 0), self.depth.get(b, 0)) >= \
+            if len(ts) == 2 and max(self.depth.get(a, 0), self.depth.get(b, 0)) < \
                     MAX_FOLD_SPLIT_DEPTH:
-                continue
-            if self.split(a, b, ts):
+                if not self.split(a, b, ts):
+                    return None
                 self.depth[len(self.P) - 1] = max(self.depth.get(a, 0), self.depth.get(b, 0)) + 1
-                return True
-            break  # only the longest edge: bisecting a shorter one makes worse shapes
-        return False
+                return ts
+            if not or_next:
+                return None
+        return None
 
     # ---- edits ---------------------------------------------------------------------------
 

@@ -210,6 +210,28 @@ def filleted_disk(fc, radius=40.0, fillet=1.0):
     return body.makeFillet(fillet, edge)
 
 
+def assert_local_mend_on_cad(shape, surf, out, proj, stats):
+    """What repair_curved_folds and refine_around_points promise: ``out`` passes the core's
+    exact check; the tessellation's vertices are all kept where they were, the new ones (one
+    per split) lie on their CAD faces; only local changes (each split or flip replaces at most
+    four of the old triangles); the volume is kept."""
+    core.check_surface(out)  # closed, oriented, no self-intersection (exact)
+    old = {tuple(p) for p in surf.points.tolist()}
+    assert old <= {tuple(p) for p in out.points.tolist()}
+    tags = vertex_tags(out)
+    new = [v for v, p in enumerate(out.points.tolist()) if tuple(p) not in old]
+    assert len(new) == stats["splits"]
+    for v in new:
+        for t in tags[v]:
+            assert proj.distance_to_face(out.points[v], t) < proj.face_tolerance(t) + 1e-9
+    kept = {tuple(sorted(map(tuple, surf.points[t].tolist()))) for t in surf.triangles}
+    now = {tuple(sorted(map(tuple, out.points[t].tolist()))) for t in out.triangles}
+    assert len(kept & now) >= len(surf.triangles) - 4 * (stats["splits"] + stats["flips"])
+    assert abs(cad_tessellation.signed_volume(out.points, out.triangles) -
+               cad_tessellation.signed_volume(surf.points, surf.triangles)) < \
+        1e-3 * shape.Volume
+
+
 def test_curved_folds_are_mended_locally_and_stay_on_the_cad(fc):
     from FemBspTet.cad_projection import CadProjection
     from FemBspTet.surface_remesh import repair_curved_folds
@@ -222,23 +244,7 @@ def test_curved_folds_are_mended_locally_and_stay_on_the_cad(fc):
     print(stats)
     assert stats["folded_before"] > 0
     assert stats["folded_after"] < stats["folded_before"] / 2
-    core.check_surface(out)  # closed, oriented, no self-intersection (exact)
-    # the tessellation's vertices are all kept where they were; new ones are on their faces
-    old = {tuple(p) for p in surf.points.tolist()}
-    assert old <= {tuple(p) for p in out.points.tolist()}
-    tags = vertex_tags(out)
-    new = [v for v, p in enumerate(out.points.tolist()) if tuple(p) not in old]
-    assert len(new) == stats["splits"]
-    for v in new:
-        for t in tags[v]:
-            assert proj.distance_to_face(out.points[v], t) < proj.face_tolerance(t) + 1e-9
-    # only local changes: most of the tessellation's triangles are still there
-    kept = {tuple(sorted(map(tuple, surf.points[t].tolist()))) for t in surf.triangles}
-    now = {tuple(sorted(map(tuple, out.points[t].tolist()))) for t in out.triangles}
-    assert len(kept & now) >= len(surf.triangles) - 4 * (stats["splits"] + stats["flips"])
-    assert abs(cad_tessellation.signed_volume(out.points, out.triangles) -
-               cad_tessellation.signed_volume(surf.points, surf.triangles)) < \
-        1e-3 * shape.Volume
+    assert_local_mend_on_cad(shape, surf, out, proj, stats)
 
 
 def test_surface_without_folds_is_returned_unchanged(fc):
@@ -272,15 +278,6 @@ def test_needles_around_given_points_are_split_on_the_cad_and_nothing_else_chang
     out, stats = refine_around_points(surf, proj, points)
     print(stats, "worst qualities before", q[worst])
     assert stats["splits"] > 0
-    core.check_surface(out)
-    old = {tuple(p) for p in surf.points.tolist()}
-    assert old <= {tuple(p) for p in out.points.tolist()}
-    tags = vertex_tags(out)
-    new = [v for v, p in enumerate(out.points.tolist()) if tuple(p) not in old]
-    assert len(new) == stats["splits"]
-    for v in new:
-        for t in tags[v]:
-            assert proj.distance_to_face(out.points[v], t) < proj.face_tolerance(t) + 1e-9
     # the triangles at the given points are better than the worst of them was
     keys = {tuple(p) for p in points.tolist()}
     at = [t for t in out.triangles if any(tuple(p) in keys for p in out.points[t].tolist())]
@@ -289,10 +286,4 @@ def test_needles_around_given_points_are_split_on_the_cad_and_nothing_else_chang
                / len(ts) for x, ts in ((surf, before), (out, at))]
     print("share of needles at the points: before %.2f, after %.2f" % tuple(needles))
     assert needles[1] < needles[0]
-    # only local changes: each split or flip replaces at most four of the old triangles
-    kept = {tuple(sorted(map(tuple, surf.points[t].tolist()))) for t in surf.triangles}
-    now = {tuple(sorted(map(tuple, out.points[t].tolist()))) for t in out.triangles}
-    assert len(kept & now) >= len(surf.triangles) - 4 * (stats["splits"] + stats["flips"])
-    assert abs(cad_tessellation.signed_volume(out.points, out.triangles) -
-               cad_tessellation.signed_volume(surf.points, surf.triangles)) < \
-        1e-3 * shape.Volume
+    assert_local_mend_on_cad(shape, surf, out, proj, stats)
