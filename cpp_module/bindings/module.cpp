@@ -298,6 +298,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["collapses"] = st.collapses;
         d["flips23"] = st.flips23;
         d["flips32"] = st.flips32;
+        d["edge_removals"] = st.edge_removals;
         d["relocations"] = st.relocations;
         d["insertions"] = st.insertions;
         d["size_passes"] = st.size_passes;

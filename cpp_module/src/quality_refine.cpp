@@ -19,6 +19,8 @@ namespace bsptet {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Edge removals (RefineMesh::remove_edge) look at shells of at most this many tets.
+constexpr int kMaxEdgeRing = 7;
 
 // Face (A, B, C) of a tet whose fourth corner is D, for placing points over it.
 struct FaceFrame {
@@ -538,8 +540,8 @@ class Refiner {
   }
 
   // Tries to make the invalid curved element t valid by changing the connectivity around it: 2-3
-  // flips of its interior faces, 3-2 flips of its interior edges, then collapses of its interior
-  // Steiner corners onto a neighbour. A change is applied when it lowers the number of invalid
+  // flips of its interior faces, 3-2 flips and removals of its interior edges, then collapses of
+  // its interior Steiner corners onto a neighbour. A change is applied when it lowers the number of invalid
   // curved elements among the tets it replaces and none of its new tets is below min(1 degree,
   // the worst old tet's) (as the lifts below). The surface never changes. True when one was made.
   template <class CurvedOk, class Corners>
@@ -573,6 +575,11 @@ class Refiner {
     for (const auto& e : kEdge)
       if (m_.flip32(q[e[0]], q[e[1]], accept)) {
         ++st_.flips32;
+        return true;
+      }
+    for (const auto& e : kEdge)
+      if (m_.remove_edge(q[e[0]], q[e[1]], kMaxEdgeRing, accept)) {
+        ++st_.edge_removals;
         return true;
       }
     for (int k = 0; k < 4; ++k) {
@@ -633,6 +640,12 @@ class Refiner {
             ++st_.flips23;
             done = true;
           }
+        for (int i = 0; i < 4 && !done; ++i)
+          for (int j = i + 1; j < 4 && !done; ++j)
+            if (m_.remove_edge(q[i], q[j], kMaxEdgeRing)) {
+              ++st_.edge_removals;
+              done = true;
+            }
         now += done;
       }
       flips += now;

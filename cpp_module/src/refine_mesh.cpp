@@ -586,6 +586,104 @@ bool RefineMesh::flip32(Index u, Index v, const TetsAccept& accept) {
   return true;
 }
 
+bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& accept) {
+  const std::vector<Index> shell = tets_around_edge(u, v);
+  const int n = static_cast<int>(shell.size());
+  if (n < 3 || n > max_ring) return false;
+  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
+  // The ring: for every tet {u, v, p, q} (an even permutation of its corners), q follows p.
+  std::vector<std::pair<Index, Index>> links;
+  for (Index s : shell) {
+    const auto& r = tet(s);
+    Index p = -1, q = -1;
+    for (Index w : r)
+      if (w != u && w != v) (p < 0 ? p : q) = w;
+    if (q < 0) return false;
+    if (!even_permutation(r, {u, v, p, q})) std::swap(p, q);
+    links.emplace_back(p, q);
+  }
+  std::vector<Index> ring{links[0].first};
+  for (int i = 0; i < n; ++i) {
+    auto it = std::find_if(links.begin(), links.end(), [&](const auto& l) { return l.first == ring.back(); });
+    if (it == links.end()) return false;
+    ring.push_back(it->second);
+  }
+  if (ring.back() != ring.front()) return false;
+  ring.pop_back();
+  {
+    std::vector<Index> sorted = ring;
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
+  }
+  const auto W = [&](int i) { return ring[static_cast<std::size_t>(i)]; };
+  // Tets of ring triangle (i, k, j), i < k < j in ring order.
+  const auto tets_of = [&](int i, int k, int j) {
+    return std::array<std::array<Index, 4>, 2>{{{W(k), W(i), W(j), u}, {W(i), W(k), W(j), v}}};
+  };
+  // Diagonals (i, j), j - i >= 2, (i, j) != (0, n - 1), must not be mesh edges yet; the single
+  // triangle of n = 3 must not be a mesh face.
+  std::vector<char> diagonal_ok(static_cast<std::size_t>(n * n), 1);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 2; j < n; ++j)
+      if (!(i == 0 && j == n - 1)) diagonal_ok[static_cast<std::size_t>(i * n + j)] = !edge_exists(W(i), W(j));
+  if (n == 3)
+    for (Index s : tets_around_edge(W(0), W(1)))
+      if (std::find(tet(s).begin(), tet(s).end(), W(2)) != tet(s).end()) return false;
+  // best[i][j]: the best worst angle of a triangulation of the sub-polygon i..j (j - i >= 2);
+  // -1: none is valid.
+  const double kNone = -1;
+  std::vector<double> best(static_cast<std::size_t>(n * n), std::numeric_limits<double>::infinity());
+  std::vector<int> choice(static_cast<std::size_t>(n * n), -1);
+  for (int len = 2; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      double b = kNone;
+      int c = -1;
+      if (diagonal_ok[static_cast<std::size_t>(i * n + j)])
+        for (int k = i + 1; k < j; ++k) {
+          const double left = best[static_cast<std::size_t>(i * n + k)], right = best[static_cast<std::size_t>(k * n + j)];
+          if (left <= kNone || right <= kNone) continue;
+          double q = std::min(left, right);
+          if (q <= b) continue;
+          for (const auto& t : tets_of(i, k, j)) {
+            if (!positive(t)) {
+              q = kNone;
+              break;
+            }
+            q = std::min(q, quality_of(t));
+            if (q <= b) break;
+          }
+          if (q > b) b = q, c = k;
+        }
+      best[static_cast<std::size_t>(i * n + j)] = c < 0 ? kNone : b;
+      choice[static_cast<std::size_t>(i * n + j)] = c;
+    }
+  const double got = best[static_cast<std::size_t>(n - 1)];
+  if (got <= kNone) return false;
+  double old_min = 180;
+  for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
+  if (!accept && got <= old_min + kImprovement) return false;
+  std::vector<std::array<Index, 4>> created;
+  std::vector<std::pair<int, int>> todo{{0, n - 1}};
+  while (!todo.empty()) {
+    const auto [i, j] = todo.back();
+    todo.pop_back();
+    if (j - i < 2) continue;
+    const int k = choice[static_cast<std::size_t>(i * n + j)];
+    for (const auto& t : tets_of(i, k, j)) created.push_back(t);
+    todo.emplace_back(i, k);
+    todo.emplace_back(k, j);
+  }
+  if (accept) {
+    std::vector<std::array<Index, 4>> removed;
+    for (Index s : shell) removed.push_back(tet(s));
+    if (!accept(removed, created)) return false;
+  }
+  for (Index s : shell) kill_tet(s);
+  for (const auto& c : created) add_tet(c);
+  return true;
+}
+
 Index RefineMesh::neighbour(Index t, int k) {
   const auto q = tet(t);
   const Index a = q[kOppositeFace[k][0]], b = q[kOppositeFace[k][1]], c = q[kOppositeFace[k][2]];

@@ -99,6 +99,96 @@ TEST(RefineMesh, NoExactPointOnAGenericEdgeInExactMode) {
   EXPECT_FALSE(check_mesh(s, rounded.to_tet_mesh()).valid);
 }
 
+namespace {
+
+// The n tets around the interior edge u = n, v = n + 1 (u above the ring's plane z = 0, v below):
+// ring points 0..n-1 at the given (x, y), counter-clockwise seen from above; the closed surface is
+// the two cones over the ring.
+void edge_shell(SurfaceMesh& s, TetMesh& m, const std::vector<std::array<double, 2>>& ring, const Vec3& u,
+                const Vec3& v) {
+  const Index n = static_cast<Index>(ring.size());
+  s.xyz.clear();
+  s.tri.clear();
+  for (const auto& w : ring) s.xyz.insert(s.xyz.end(), {w[0], w[1], 0});
+  s.xyz.insert(s.xyz.end(), {u.x, u.y, u.z, v.x, v.y, v.z});
+  m.tet.clear();
+  for (Index i = 0; i < n; ++i) {
+    const Index j = (i + 1) % n;
+    s.tri.insert(s.tri.end(), {i, j, n, j, i, n + 1});
+    m.tet.insert(m.tet.end(), {i, j, n + 1, n});
+  }
+  m.xyz = s.xyz;
+}
+
+double worst_angle(RefineMesh& r) {
+  double w = 180;
+  for (Index t = 0; t < r.num_tet_slots(); ++t)
+    if (r.tet_alive(t)) w = std::min(w, r.tet_quality(t));
+  return w;
+}
+
+}  // namespace
+
+TEST(RefineMesh, EdgeRemovalReplacesTheShellByTheBestValidTriangulationOfItsRing) {
+  // A hexagon around a long edge through a point near one ring corner: the wedges next to that
+  // corner are slivers.
+  std::vector<std::array<double, 2>> hexagon;
+  for (int k = 0; k < 6; ++k) hexagon.push_back({std::cos(k * M_PI / 3), std::sin(k * M_PI / 3)});
+  SurfaceMesh s;
+  TetMesh m;
+  edge_shell(s, m, hexagon, {0.8, 0.05, 0.9}, {0.8, 0.05, -0.9});
+  ASSERT_TRUE(check_mesh(s, m).valid);
+  RefineMesh r(s, m);
+  const double before = worst_angle(r);
+  // Refused by the acceptance hook: nothing changes, the hook saw 6 old and 8 new tets.
+  std::size_t removed_seen = 0, created_seen = 0;
+  EXPECT_FALSE(r.remove_edge(6, 7, 7, [&](const auto& removed, const auto& created) {
+    removed_seen = removed.size();
+    created_seen = created.size();
+    return false;
+  }));
+  EXPECT_EQ(removed_seen, 6u);
+  EXPECT_EQ(created_seen, 8u);
+  EXPECT_EQ(r.num_alive_tets(), 6);
+  // A ring larger than allowed: not tried.
+  EXPECT_FALSE(r.remove_edge(6, 7, 5));
+  // A boundary edge: never.
+  EXPECT_FALSE(r.remove_edge(0, 6));
+  ASSERT_TRUE(r.remove_edge(6, 7));
+  EXPECT_EQ(r.num_alive_tets(), 8);
+  EXPECT_TRUE(r.tets_around_edge(6, 7).empty());
+  EXPECT_GT(worst_angle(r), before + 10);  // 13.5 -> 29.6 degrees
+  const TetMesh out = r.to_tet_mesh();
+  EXPECT_TRUE(check_mesh(s, out).valid);
+}
+
+TEST(RefineMesh, EdgeRemovalOnANonConvexRingUsesOnlyDiagonalsInsideIt) {
+  // A star-shaped, non-convex ring (radii alternating 1 and 0.35): the diagonals between its outer
+  // corners pass outside it (at 0.5 from the axis), so every triangulation with one of them has a
+  // negative tet; the best valid one (the inner triangle and three ears) raises the worst angle.
+  std::vector<std::array<double, 2>> star;
+  for (int k = 0; k < 6; ++k) {
+    const double r = k % 2 ? 0.35 : 1.0;
+    star.push_back({r * std::cos(k * M_PI / 3), r * std::sin(k * M_PI / 3)});
+  }
+  SurfaceMesh s;
+  TetMesh m;
+  edge_shell(s, m, star, {0.0, 0.0, 2.0}, {0.0, 0.0, -2.0});
+  ASSERT_TRUE(check_mesh(s, m).valid);
+  RefineMesh r(s, m);
+  const double before = worst_angle(r);
+  ASSERT_TRUE(r.remove_edge(6, 7));
+  EXPECT_TRUE(check_mesh(s, r.to_tet_mesh()).valid);
+  EXPECT_EQ(r.num_alive_tets(), 8);
+  EXPECT_GT(worst_angle(r), before + 10);  // 22.3 -> 44.7 degrees
+  for (Index t = 0; t < r.num_tet_slots(); ++t) {
+    if (!r.tet_alive(t)) continue;
+    int outer = 0;
+    for (Index w : r.tet(t)) outer += w < 6 && w % 2 == 0;
+    EXPECT_LE(outer, 1) << "a tet on a diagonal between two outer corners";
+  }
+}
+
 TEST(RefineMesh, InsertPointFillsItsCavityExactlyAndRespectsItsAcceptance) {
   SurfaceMesh s;
   TetMesh m;

@@ -97,13 +97,14 @@ int main(int argc, char** argv) {
     const MeshCheckReport r = check_mesh(reference, m);
     std::printf("%s: %s h %.6g core tets %d min_dihedral %.2f -> tets %d points %d min_dihedral %.2f p1 %.2f "
                 "median %.2f max_radius_edge %.3g splits %lld (surface %lld, no exact point %lld, rejected %lld) "
-                "collapses %lld flips %lld/%lld moves %lld inserted %lld long_left %lld core_s %.3f refine_s %.3f\n",
+                "collapses %lld flips %lld/%lld/%lld moves %lld inserted %lld long_left %lld core_s %.3f refine_s %.3f\n",
                 argv[1], r.valid ? "VALID" : "INVALID", o.size, core.num_tets(), before.quality.min_dihedral_deg,
                 m.num_tets(), m.num_points(), r.quality.min_dihedral_deg, r.quality.p1_dihedral_deg,
                 r.quality.median_dihedral_deg, r.quality.max_radius_edge_ratio, static_cast<long long>(st.splits),
                 static_cast<long long>(st.surface_splits), static_cast<long long>(st.splits_no_exact_point),
                 static_cast<long long>(st.splits_rejected), static_cast<long long>(st.collapses),
                 static_cast<long long>(st.flips23), static_cast<long long>(st.flips32),
+                static_cast<long long>(st.edge_removals),
                 static_cast<long long>(st.relocations), static_cast<long long>(st.insertions),
                 static_cast<long long>(st.long_edges_left),
                 cst.seconds_total, st.seconds);

@@ -1,5 +1,6 @@
 // FemBspTet quality stage: an editable tetrahedral mesh of a closed input surface, changed only by
-// local operations (edge split, edge collapse, 2-3 and 3-2 flips, point relocation) that are each
+// local operations (edge split, edge collapse, 2-3 and 3-2 flips, edge removal, point relocation,
+// point insertion) that are each
 // decided EXACTLY before they are applied: every tet they create must have orient3d > 0 on the
 // double coordinates (predicates.h), and every point they put on the surface must keep the boundary
 // an exact refinement of the input triangulation (below). An operation that fails a check changes
@@ -144,6 +145,18 @@ class RefineMesh {
   bool flip23(Index t, int opposite, const TetsAccept& accept = {});
   /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23.
   bool flip32(Index u, Index v, const TetsAccept& accept = {});
+  /// Edge removal (Shewchuk's "n-to-2(n-2)" flip; flip32 is n = 3): the n tets around the interior
+  /// edge (u, v), 3 <= n <= max_ring, are replaced by 2(n-2) tets: a triangulation of the ring of
+  /// their other corners (w_0 .. w_{n-1}, in order around the edge), each triangle joined to u and
+  /// to v. The triangulation is the one that maximizes the smallest min dihedral angle of its tets
+  /// (dynamic programming over the ring, Klincsek), among those whose tets are all positive
+  /// (exact) and whose diagonals are not edges of the mesh yet. Applied when that angle is above
+  /// the worst old tet's; with `accept`, when `accept` agrees (the angle test is then the
+  /// caller's). Why the result is valid: the new tets are positive and, as a chain, have the same
+  /// boundary as the old ones (the faces (u, w_i, w_i+1) and (v, w_i, w_i+1)), so they cover the
+  /// old tets' union exactly once; the boundary of the solid is never touched (the edge is
+  /// interior, the ring faces stay).
+  bool remove_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {});
   /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
   /// tet `start` that never crosses a boundary face (kOutside when it would: p is outside the
   /// solid or on its boundary). The cavity is the tets whose circumsphere contains p (computed in
