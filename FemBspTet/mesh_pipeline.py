@@ -308,6 +308,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     surfaces = cad_tessellation.tessellate_shape(shape, deflection, params.angular_deflection,
                                                  source=source)
     check_cancel()
+    # fins (near-collinear triangles along CAD edges) make flat tets whatever the core does
+    surfaces, fin_stats = flip_out_fins_of(surfaces)
     projection = CadProjection(shape)
     options = core_options(params, projection)
     element_size = params.max_size if params.max_size > 0 else automatic_element_size(shape)
@@ -411,6 +413,8 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     stats["projected_nodes"] = int(len(moved))
     stats["max_projection_mm"] = float(max_move)
     stats["linear_deflection"] = float(deflection)
+    if fin_stats["flips"]:
+        stats["tessellation_fins"] = fin_stats
     if remesh_stats:
         stats["surface_remesh"] = remesh_stats
     notes = remesh_notes + list(stats.get("notes", []))
@@ -530,6 +534,22 @@ def _mend_each_surface(surfaces, mend, summed, better=lambda st: True):
             total[k] += st[k]
         out.append(new)
     return out, total
+
+
+def flip_out_fins_of(surfaces):
+    """Each solid's tessellation through :func:`FemBspTet.surface_remesh.flip_out_fins` (its
+    near-collinear triangles flipped away inside their CAD faces; faces two solids share are
+    left alone). A changed surface is used only if it passes the core's exact input check; else
+    the solid keeps its tessellation. Returns ``(surfaces, stats)``, stats summed over the
+    solids whose surface changed (``fins_before``, ``fins_after``, ``flips``, ``not_used``)."""
+    from .surface_remesh import flip_out_fins
+
+    def mend(surf, frozen):
+        t0 = time.perf_counter()
+        new, st = flip_out_fins(surf, frozen_tags=frozen)
+        return new, dict(st, seconds=time.perf_counter() - t0)
+
+    return _mend_each_surface(surfaces, mend, ("fins_before", "fins_after", "flips"))
 
 
 def repair_curved_folds_of(surfaces, projection, cancel=None):
