@@ -383,6 +383,16 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
             fold_stats["bent_interior_midnodes"] = int(len(bent))
             if len(bent):  # (moved stays the projected boundary nodes, for the stats)
                 bad = elements_inverted_by_projection(mesh, np.union1d(moved, bent))
+            if len(bad):
+                report("sliding boundary mid-nodes along the CAD faces", 0.885)
+                bad, slid = slide_boundary_midnodes(mesh, faces, tags, midnodes, bad, projection,
+                                                    cancel=check_cancel)
+                fold_stats["slid_boundary_midnodes"] = int(len(slid))
+                if len(slid):
+                    bad, bent2 = bend_interior_edges(mesh, midnodes, bad, cancel=check_cancel)
+                    bent = np.union1d(bent, bent2)
+                    fold_stats["bent_interior_midnodes"] = int(len(bent))
+                    bad = elements_inverted_by_projection(mesh, np.union1d(moved, bent))
         if fold_stats:
             stats = dict(stats)
             stats["curved_repair"] = fold_stats
@@ -594,6 +604,91 @@ def bend_interior_edges(mesh, midnodes, bad, cancel=None):
     if len(midnodes):
         movable[np.asarray(midnodes).reshape(-1)] = False
     return untangle_interior_midnodes(mesh.points, mesh.tets, bad, movable, cancel=cancel)
+
+
+#: :func:`slide_boundary_midnodes`: where on its chord a mid-node's CAD place is sought (the
+#: fraction from the edge's first corner), in the order tried; 1/2 is where the projection puts
+#: it. Beyond 0.3 / 0.7 the element nears a quarter-point one (its Jacobian vanishes at a corner).
+SLIDE_FRACTIONS = (0.6, 0.4, 0.65, 0.35, 0.7, 0.3, 0.55, 0.45)
+#: :func:`slide_boundary_midnodes`: passes over the inverted elements at most.
+SLIDE_ROUNDS = 4
+
+
+def slide_boundary_midnodes(mesh, faces, tags, midnodes, bad, projection, rounds=None,
+                            cancel=None):
+    """Slide boundary mid-nodes of the tet10 elements ``bad`` along their CAD face or edge.
+
+    A boundary mid-node must lie on its CAD face (or on the CAD edge of its two faces) for
+    FreeCAD's constraints to find it, but not at the projection of its chord's midpoint: any
+    point of the CAD there is as good for that. Where a needle triangle runs along a curved CAD
+    edge, the curved edge's tangent at the needle's sharp corner turns past the needle's other
+    edge and every element on it folds there; putting the mid-node nearer the other corner
+    (the CAD point nearest the chord point at fraction ``SLIDE_FRACTIONS`` of the way) turns
+    that tangent back, at the expense of the other end. A place is taken when it raises the
+    smallest scaled Jacobian (:mod:`FemBspTet.curved_untangle`) over every element containing
+    the mid-node; corners and interior nodes never move here, and a place where another node
+    already is is never taken. Modifies ``mesh.points`` in place.
+
+    ``rounds``: passes over ``bad`` at most (None: ``SLIDE_ROUNDS``). Returns ``(still bad,
+    slid nodes)``.
+    """
+    from .curved_untangle import _scales, jacobians
+
+    rounds = SLIDE_ROUNDS if rounds is None else rounds
+    bad = np.unique(np.asarray(bad, dtype=np.int64))
+    if len(bad) == 0 or len(midnodes) == 0:
+        return bad, np.zeros(0, dtype=np.int64)
+    pts, tets = mesh.points, mesh.tets
+    node_tags = {}
+    for f, t in zip(np.asarray(midnodes).tolist(), tags.tolist()):
+        for m in f:
+            node_tags.setdefault(m, set()).add(int(t))
+    owners = {}
+    hit_e, hit_k = np.nonzero(np.isin(tets[:, 4:10], list(node_tags)))
+    for e, k in zip(hit_e.tolist(), hit_k.tolist()):
+        owners.setdefault(int(tets[e, 4 + k]), []).append((e, k))
+    _, scale = _scales(pts, tets)
+    taken = {tuple(p) for p in pts.tolist()}
+
+    def worst(elems):
+        return float((jacobians(pts[tets[elems]]).min(axis=1) / scale[elems]).min())
+
+    slid = set()
+    for _ in range(max(0, int(rounds))):
+        if cancel is not None:
+            cancel()
+        changed = False
+        for e in bad.tolist():
+            for k in range(6):
+                m = int(tets[e, 4 + k])
+                if m not in node_tags:
+                    continue
+                elems = np.array(sorted({el for el, _ in owners[m]}), dtype=np.int64)
+                i, j = _TET10_EDGES[k]
+                u, v = pts[tets[e, i]], pts[tets[e, j]]
+                home = pts[m].copy()
+                best = (worst(elems), None)
+                for frac in SLIDE_FRACTIONS:
+                    q = np.array(projection.to_faces(u + frac * (v - u), node_tags[m]),
+                                 dtype=np.float64)
+                    if not np.all(np.isfinite(q)) or tuple(q.tolist()) in taken:
+                        continue
+                    pts[m] = q
+                    value = worst(elems)
+                    pts[m] = home
+                    if value > best[0]:
+                        best = (value, q)
+                if best[1] is not None:
+                    taken.discard(tuple(home.tolist()))
+                    pts[m] = best[1]
+                    taken.add(tuple(best[1].tolist()))
+                    slid.add(m)
+                    changed = True
+        jac = jacobians(pts[tets[bad]]).min(axis=1)
+        bad = bad[jac <= 0]
+        if not changed or len(bad) == 0:
+            break
+    return bad, np.array(sorted(slid), dtype=np.int64)
 
 
 def shape_face_names(projection):

@@ -19,6 +19,7 @@ if not freecad_available():
                 allow_module_level=True)
 
 from FemBspTet import cad_tessellation, core, mesh_pipeline  # noqa: E402
+from FemBspTet.errors import InternalError  # noqa: E402
 from FemBspTet.surface_remesh import remesh_surface, triangle_quality_stats  # noqa: E402
 
 
@@ -287,3 +288,42 @@ def test_needles_around_given_points_are_split_on_the_cad_and_nothing_else_chang
     print("share of needles at the points: before %.2f, after %.2f" % tuple(needles))
     assert needles[1] < needles[0]
     assert_local_mend_on_cad(shape, surf, out, proj, stats)
+
+
+def filleted_cylinder(fc, radius=10.0, fillet=1.0):
+    _, Part, _ = fc
+    body = Part.makeCylinder(radius, 50)
+    edge = [e for e in body.Edges if type(e.Curve).__name__ == "Circle"
+            and abs(e.BoundBox.ZMin - 50) < 1e-9]
+    return body.makeFillet(fillet, edge)
+
+
+def test_boundary_midnodes_slide_along_the_cad_where_a_fillet_needle_folds(fc, monkeypatch):
+    """A 1 mm fillet on a cylinder of radius 10: OpenCASCADE's strip of needles along the fillet
+    folds some curved elements whatever is done inside. Sliding their boundary mid-nodes along
+    the CAD (mesh_pipeline.slide_boundary_midnodes) mends them: the mesh is made, every element's
+    Jacobian is positive, and every boundary node, the slid ones included, is on its CAD face
+    within the face's tolerance. Without the slides (and without the pipeline's later attempts on
+    a mended tessellation) the same shape stops with the message."""
+    freecad, Part, _ = fc
+    shape = placed(fc, filleted_cylinder(fc))
+    params = mesh_pipeline.MeshParameters(order=2)
+    monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)  # one core run: no surface mend
+    result = mesh_pipeline.mesh_cad_shape(shape, params)
+    repair = result.stats["curved_repair"]
+    print("curved repair:", repair)
+    assert repair["slid_boundary_midnodes"] > 0
+    jac = mesh_pipeline.tet10_jacobians(result.mesh.points, result.mesh.tets)
+    assert (jac > 0).all()
+    faces = result.boundary_faces
+    for tag in sorted(set(result.boundary_face_tags.tolist())):
+        face = shape.Faces[tag]
+        tol = max(face.Tolerance, 1e-7)
+        for n in result.face_nodes(tag).tolist():
+            d = face.distToShape(Part.Vertex(freecad.Vector(*result.mesh.points[n])))[0]
+            assert d <= tol, (tag, n, d)
+    assert len(faces) > 0
+
+    monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
+    with pytest.raises(InternalError, match="would invert"):
+        mesh_pipeline.mesh_cad_shape(shape, params)

@@ -81,9 +81,12 @@ class Refiner {
     compute_targets();
     size_phase();
     optimize_phase(o_.optimize_rounds);
-    // Collapses and smoothing may have left some edges long again: one more short round.
+    // Collapses and smoothing may have left some edges long again: one more short round, whose
+    // splits never make a tet worse than the worst of the tets they replace (after the
+    // optimization, a free split here could leave a sliver no later pass removes: the
+    // Schoenhardt polyhedron went from 11 to 1.6 degrees).
     if (o_.max_passes > 0) {
-      size_phase();
+      size_phase(180.0);
       optimize_phase(std::min(2, o_.optimize_rounds));
     }
     compute_targets();
@@ -265,7 +268,8 @@ class Refiner {
     budget_ = m_.num_points() + static_cast<Index>(std::min(estimate + 1000.0, 5e8));
   }
 
-  void size_phase() {
+  // `min_quality`: as RefineMesh::split_edge's (0: any valid split).
+  void size_phase(double min_quality = 0) {
     set_budget();
     for (int pass = 0; pass < o_.max_passes; ++pass) {
       poll("refining to size", std::min(0.5, 0.05 * pass));
@@ -278,7 +282,7 @@ class Refiner {
       std::int64_t done = 0;
       for (const auto& [key, u, v] : todo) {
         if (m_.num_points() >= budget_) break;
-        done += split(u, v, 0) ? 1 : 0;
+        done += split(u, v, min_quality) ? 1 : 0;
       }
       ++st_.size_passes;
       flip_pass(30.0);
