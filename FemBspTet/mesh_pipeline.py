@@ -45,6 +45,11 @@ import time
 import numpy as np
 
 from .errors import BspTetError, InputError, InternalError, MeshingCancelled
+
+
+class CurvedElementsInverted(InternalError):
+    """tet10: placing the boundary mid-nodes on the CAD faces would invert elements, after
+    every mend the pipeline has (the message names the first element and its CAD face)."""
 from .mesh_types import TetMesh
 
 #: Name of each MeshParameters field in ``core.tetrahedralize``'s options (``core.OPTION_NAMES``).
@@ -273,6 +278,11 @@ def brep_copy(shape):
     return copy
 
 
+#: tet10: when every mend leaves inverted elements, one more attempt on a tessellation whose
+#: AngularDeflection is this many times finer (featuretype meshes so, with twice the tets).
+FINER_TESSELLATION_FACTOR = 2.0
+
+
 def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_is_brep_copy=False):
     """Mesh every solid of ``shape`` (a ``Part.Shape``) with ``params``; see the module docstring.
 
@@ -283,15 +293,56 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     cancel:   ``cancel()`` returning True stops the run with MeshingCancelled.
     source:   a name for messages (the document object's label, a file name).
 
+    tet10 without RemeshSurface: if curved mid-nodes still invert elements after every mend,
+    the shape is meshed once more from a tessellation with an AngularDeflection
+    ``FINER_TESSELLATION_FACTOR`` times finer (one core run and the local mends, no surface
+    rounds); its mesh is returned with a note saying so and ``stats["angular_deflection_used"]``,
+    or, if that fails too, the first attempt's error is raised.
+
     Returns a :class:`MeshResult`. Raises InputError (not a solid, open shell, bad parameter,
     an option the core cannot honour: the message says what and where), MeshingCancelled, or
-    InternalError (the core failed; the message says so).
+    InternalError (the core failed; the message says so; :class:`CurvedElementsInverted` for
+    tet10 elements the curved boundary inverts).
+    """
+    params = params.validate() if isinstance(params, MeshParameters) else \
+        MeshParameters.from_dict(dict(params))
+    if not shape_is_brep_copy:
+        shape = brep_copy(shape)
+    try:
+        return _mesh_cad_shape_once(shape, params, progress, cancel, source)
+    except CurvedElementsInverted as first:
+        if params.order != 2 or params.remesh_surface:
+            raise
+        finer = dataclasses.replace(
+            params, angular_deflection=params.angular_deflection / FINER_TESSELLATION_FACTOR)
+        report = progress or (lambda stage, fraction: None)
+
+        def again(stage, fraction):
+            report("finer tessellation (AngularDeflection %.3g): %s"
+                   % (finer.angular_deflection, stage), fraction)
+
+        try:
+            result = _mesh_cad_shape_once(shape, finer, again, cancel, source, repair_rounds=0)
+        except CurvedElementsInverted:
+            raise first from None
+        result.stats["angular_deflection_used"] = float(finer.angular_deflection)
+        result.notes.append(
+            "tet10: with AngularDeflection %.3g the curved mid-nodes inverted elements (%s); the "
+            "mesh was made from a finer tessellation, AngularDeflection %.3g"
+            % (params.angular_deflection, str(first).split(". No mesh")[0],
+               finer.angular_deflection))
+        return result
+
+
+def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=None):
+    """One run of the pipeline on ``shape`` (a BREP copy) with validated ``params``.
+    ``repair_rounds``: tet10 attempts on a mended surface after the first (None: the default,
+    ``LOCAL_REFINEMENT_ROUNDS`` with RemeshSurface, ``CURVED_REPAIR_ROUNDS`` without). The
+    rest as :func:`mesh_cad_shape`.
     """
     from . import cad_tessellation, core
     from .cad_projection import CadProjection
 
-    params = params.validate() if isinstance(params, MeshParameters) else \
-        MeshParameters.from_dict(dict(params))
     t_start = time.perf_counter()
     report = progress or (lambda stage, fraction: None)
 
@@ -300,8 +351,6 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
             raise MeshingCancelled("cancelled: no mesh was made")
 
     report("tessellating the CAD faces", 0.0)
-    if not shape_is_brep_copy:
-        shape = brep_copy(shape)
     size = params.max_size if params.max_size > 0 else None
     deflection = params.linear_deflection or \
         cad_tessellation.default_linear_deflection(shape, size)
@@ -323,8 +372,9 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     # attempts on the best surface so far, its folding curved triangles (repair_curved_folds_of)
     # or its needles around the inverted elements (refine_around_points_of) mended, each kept
     # only if it inverts fewer elements (they help some parts and not others: measured)
-    rounds = (LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else CURVED_REPAIR_ROUNDS) \
-        if params.order == 2 else 0
+    if repair_rounds is None:
+        repair_rounds = LOCAL_REFINEMENT_ROUNDS if params.remesh_surface else CURVED_REPAIR_ROUNDS
+    rounds = repair_rounds if params.order == 2 else 0
 
     def core_progress(stage, fraction):
         report(stage, None if fraction is None else 0.05 + 0.8 * float(fraction))
@@ -957,7 +1007,7 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
             flat = ("; the mesh's worst dihedral angle is %.3g degrees: elements next to the "
                     "curved face are thinner than the distance their mid-nodes move onto it"
                     % min_dihedral) if min_dihedral is not None else ""
-            raise InternalError(
+            raise CurvedElementsInverted(
                 "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
                 "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
                 "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "

@@ -304,7 +304,7 @@ def test_boundary_midnodes_slide_along_the_cad_where_a_fillet_needle_folds(fc, m
     the CAD (mesh_pipeline.slide_boundary_midnodes) mends them: the mesh is made, every element's
     Jacobian is positive, and every boundary node, the slid ones included, is on its CAD face
     within the face's tolerance. Without the slides (and without the pipeline's later attempts on
-    a mended tessellation) the same shape stops with the message."""
+    a mended or a finer tessellation) the same shape stops with the message."""
     freecad, Part, _ = fc
     shape = placed(fc, filleted_cylinder(fc))
     params = mesh_pipeline.MeshParameters(order=2)
@@ -325,5 +325,48 @@ def test_boundary_midnodes_slide_along_the_cad_where_a_fillet_needle_folds(fc, m
     assert len(faces) > 0
 
     monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
-    with pytest.raises(InternalError, match="would invert"):
-        mesh_pipeline.mesh_cad_shape(shape, params)
+    with pytest.raises(InternalError, match="would invert"):  # (no finer-tessellation attempt)
+        mesh_pipeline._mesh_cad_shape_once(mesh_pipeline.brep_copy(shape), params, None, None, "")
+
+
+def test_tet10_falls_back_to_a_finer_tessellation_and_says_so(fc, monkeypatch):
+    """With the slides and the surface mends off, the filleted cylinder's first attempt stops on
+    inverted elements; mesh_cad_shape then meshes it once more from a tessellation with half the
+    AngularDeflection, returns that valid mesh (every boundary node on its CAD face) and says so
+    in a note and in the stats."""
+    freecad, Part, _ = fc
+    monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
+    monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)
+    shape = filleted_cylinder(fc)
+    params = mesh_pipeline.MeshParameters(order=2)
+    stages = []
+    result = mesh_pipeline.mesh_cad_shape(shape, params,
+                                          progress=lambda stage, f: stages.append(stage))
+    assert result.stats["angular_deflection_used"] == params.angular_deflection / 2
+    assert any("finer tessellation" in n and "AngularDeflection 0.25" in n for n in result.notes)
+    assert any(s.startswith("finer tessellation") for s in stages)
+    jac = mesh_pipeline.tet10_jacobians(result.mesh.points, result.mesh.tets)
+    assert (jac > 0).all()
+    for tag in sorted(set(result.boundary_face_tags.tolist())):
+        face = shape.Faces[tag]
+        for n in result.face_nodes(tag).tolist():
+            d = face.distToShape(Part.Vertex(freecad.Vector(*result.mesh.points[n])))[0]
+            assert d <= max(face.Tolerance, 1e-7), (tag, n, d)
+
+
+def test_tet10_failing_also_when_finer_raises_the_first_attempts_message(fc, monkeypatch):
+    monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
+    monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)
+    seen = []
+    real = mesh_pipeline._mesh_cad_shape_once
+
+    def spy(shape, params, *args, **kwargs):
+        seen.append(params.angular_deflection)
+        return real(shape, params, *args, **kwargs)
+
+    monkeypatch.setattr(mesh_pipeline, "_mesh_cad_shape_once", spy)
+    with pytest.raises(mesh_pipeline.CurvedElementsInverted, match="would invert") as err:
+        mesh_pipeline.mesh_cad_shape(filleted_cylinder(fc, radius=20.0),
+                                     mesh_pipeline.MeshParameters(order=2))
+    assert seen == [0.5, 0.25]
+    assert "ElementOrder 1st" in str(err.value)
