@@ -40,6 +40,7 @@ Stages:
 import dataclasses
 import json
 import math
+import re
 import time
 
 import numpy as np
@@ -297,7 +298,7 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     the shape is meshed once more from a tessellation with an AngularDeflection
     ``FINER_TESSELLATION_FACTOR`` times finer (one core run and the local mends, no surface
     rounds); its mesh is returned with a note saying so and ``stats["angular_deflection_used"]``,
-    or, if that fails too, the first attempt's error is raised.
+    or, if that fails too, the first attempt's error is raised with a sentence on the second.
 
     Returns a :class:`MeshResult`. Raises InputError (not a solid, open shell, bad parameter,
     an option the core cannot honour: the message says what and where), MeshingCancelled, or
@@ -323,8 +324,12 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
 
         try:
             result = _mesh_cad_shape_once(shape, finer, again, cancel, source, repair_rounds=0)
-        except CurvedElementsInverted:
-            raise first from None
+        except CurvedElementsInverted as second:
+            count = re.search(r"would invert (\d+) element", str(second))
+            raise CurvedElementsInverted(
+                "%s. A finer tessellation (AngularDeflection %.3g) was tried too: it inverted %s "
+                "element(s)" % (str(first).rstrip("."), finer.angular_deflection,
+                                count.group(1) if count else "some")) from None
         result.stats["angular_deflection_used"] = float(finer.angular_deflection)
         result.notes.append(
             "tet10: with AngularDeflection %.3g the curved mid-nodes inverted elements (%s); the "

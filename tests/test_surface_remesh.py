@@ -355,6 +355,7 @@ def test_tet10_falls_back_to_a_finer_tessellation_and_says_so(fc, monkeypatch):
 
 
 def test_tet10_failing_also_when_finer_raises_the_first_attempts_message(fc, monkeypatch):
+    """Both attempts fail: the first attempt's message, with a sentence on the second."""
     monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
     monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)
     seen = []
@@ -370,3 +371,4 @@ def test_tet10_failing_also_when_finer_raises_the_first_attempts_message(fc, mon
                                      mesh_pipeline.MeshParameters(order=2))
     assert seen == [0.5, 0.25]
     assert "ElementOrder 1st" in str(err.value)
+    assert "finer tessellation (AngularDeflection 0.25) was tried too" in str(err.value)

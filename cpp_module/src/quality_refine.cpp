@@ -92,7 +92,14 @@ class Refiner {
     compute_targets();
     for (const auto& e : m_.edges())
       if (is_long(e[0], e[1])) ++st_.long_edges_left;
-    if (o_.separate_face_tags && !m_.surface().tag.empty()) separate_face_tags();
+    if (o_.separate_face_tags && !m_.surface().tag.empty()) {
+      separate_face_tags();
+      // Its splits end where the optimization has stopped. Only moves of interior points follow
+      // (a flip could join three points of one CAD face into an interior face again; a move
+      // changes no connectivity), each raising the worst tet around the point.
+      for (int round = 0; round < 3 && smooth_pass(30.0) > 0; ++round) {
+      }
+    }
     lift_for_curved_elements();
   }
 
