@@ -61,7 +61,8 @@ def _ext(path):
 
 
 def load_input(path, size=None):
-    """Reads a surface file or tessellates a CAD file. Returns a list of Surfaces (one per solid)."""
+    """Reads a surface file or tessellates a CAD file (its fins flipped away,
+    :func:`FemBspTet.surface_remesh.flip_out_fins`). Returns a list of Surfaces (one per solid)."""
     ext = _ext(path)
     if ext in SURFACE_EXTENSIONS:
         from .surface_io import read_surface
@@ -69,8 +70,11 @@ def load_input(path, size=None):
         return [read_surface(path)]
     if ext in CAD_EXTENSIONS:
         from .cad_tessellation import tessellate_file
+        from .mesh_pipeline import flip_out_fins_of
 
-        return tessellate_file(path, size=size)
+        # OpenCASCADE's fins (near-collinear triangles) flipped inside their faces, as the
+        # FreeCAD pipeline does: every tet on a fin is flat
+        return flip_out_fins_of(tessellate_file(path, size=size))[0]
     raise InputError(
         f"unknown input format '{ext or '(no extension)'}'; supported: "
         + ", ".join(SURFACE_EXTENSIONS + CAD_EXTENSIONS),
