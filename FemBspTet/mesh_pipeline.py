@@ -40,18 +40,23 @@ Stages:
 import dataclasses
 import json
 import math
-import re
 import time
 
 import numpy as np
 
 from .errors import BspTetError, InputError, InternalError, MeshingCancelled
+from .mesh_types import TetMesh
 
 
 class CurvedElementsInverted(InternalError):
     """tet10: placing the boundary mid-nodes on the CAD faces would invert elements, after
-    every mend the pipeline has (the message names the first element and its CAD face)."""
-from .mesh_types import TetMesh
+    every mend the pipeline has. ``summary``: the sentence naming how many (``count``), the
+    first element and its CAD face; the message is ``summary`` followed by ``advice``."""
+
+    def __init__(self, summary, count, advice):
+        self.summary = summary
+        self.count = count
+        super().__init__(summary + advice)
 
 #: Name of each MeshParameters field in ``core.tetrahedralize``'s options (``core.OPTION_NAMES``).
 CORE_OPTION_OF = {
@@ -325,17 +330,16 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         try:
             result = _mesh_cad_shape_once(shape, finer, again, cancel, source, repair_rounds=0)
         except CurvedElementsInverted as second:
-            count = re.search(r"would invert (\d+) element", str(second))
             raise CurvedElementsInverted(
-                "%s. A finer tessellation (AngularDeflection %.3g) was tried too: it inverted %s "
-                "element(s)" % (str(first).rstrip("."), finer.angular_deflection,
-                                count.group(1) if count else "some")) from None
+                first.summary, first.count,
+                "%s. A finer tessellation (AngularDeflection %.3g) was tried too: it inverted %d "
+                "element(s)" % (str(first)[len(first.summary):].rstrip("."),
+                                finer.angular_deflection, second.count)) from None
         result.stats["angular_deflection_used"] = float(finer.angular_deflection)
         result.notes.append(
             "tet10: with AngularDeflection %.3g the curved mid-nodes inverted elements (%s); the "
             "mesh was made from a finer tessellation, AngularDeflection %.3g"
-            % (params.angular_deflection, str(first).split(". No mesh")[0],
-               finer.angular_deflection))
+            % (params.angular_deflection, first.summary, finer.angular_deflection))
         return result
 
 
@@ -1014,9 +1018,10 @@ def check_elements_after_projection(mesh, moved, faces, tags, face_names, min_di
                     % min_dihedral) if min_dihedral is not None else ""
             raise CurvedElementsInverted(
                 "placing the tet10 mid-nodes on the curved CAD faces would invert %d element(s), "
-                "first tet %d%s%s. No mesh was made (mid-nodes left off the CAD face would not be "
-                "found by the constraints). ElementOrder 1st meshes this shape (its corner nodes are "
-                "on the CAD faces)" % (len(bad), e, at, flat))
+                "first tet %d%s%s" % (len(bad), e, at, flat), len(bad),
+                ". No mesh was made (mid-nodes left off the CAD face would not be found by the "
+                "constraints). ElementOrder 1st meshes this shape (its corner nodes are on the "
+                "CAD faces)")
         flat = ("; the mesh's worst dihedral angle is %.3g degrees" % min_dihedral
                 if min_dihedral is not None else "")
         raise InternalError(

@@ -590,7 +590,7 @@ class Refiner {
         return true;
       }
     for (const auto& e : kEdge)
-      if (m_.remove_edge(q[e[0]], q[e[1]], kMaxEdgeRing, accept)) {
+      if (m_.remove_edge(q[e[0]], q[e[1]], kMaxEdgeRing, accept, 4)) {
         ++st_.edge_removals;
         return true;
       }
@@ -654,7 +654,7 @@ class Refiner {
           }
         for (int i = 0; i < 4 && !done; ++i)
           for (int j = i + 1; j < 4 && !done; ++j)
-            if (m_.remove_edge(q[i], q[j], kMaxEdgeRing)) {
+            if (m_.remove_edge(q[i], q[j], kMaxEdgeRing, {}, 4)) {
               ++st_.edge_removals;
               done = true;
             }

@@ -545,51 +545,13 @@ bool RefineMesh::flip23(Index t, int opposite_vertex, const TetsAccept& accept) 
 }
 
 bool RefineMesh::flip32(Index u, Index v, const TetsAccept& accept) {
-  const std::vector<Index> shell = tets_around_edge(u, v);
-  if (shell.size() != 3) return false;
-  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
-  std::array<Index, 4> first = tet(shell[0]);
-  Index p = -1, q = -1;
-  for (Index w : first)
-    if (w != u && w != v) (p < 0 ? p : q) = w;
-  if (!even_permutation(first, {u, v, p, q})) std::swap(p, q);
-  const Index y = p, x = q;
-  Index z = -1;
-  for (std::size_t i = 1; i < 3; ++i)
-    for (Index w : tet(shell[i]))
-      if (w != u && w != v && w != x && w != y) z = w;
-  if (z < 0) return false;
-  // The ring must be closed: tets {u,v,x,y}, {u,v,y,z}, {u,v,z,x}.
-  for (Index s : shell) {
-    int hits = 0;
-    for (Index w : tet(s)) hits += (w == x) + (w == y) + (w == z);
-    if (hits != 2) return false;
-  }
-  if (!tets_around_edge(x, y).empty()) {
-    for (Index s : tets_around_edge(x, y)) {
-      const auto& r = tet(s);
-      if (std::find(r.begin(), r.end(), z) != r.end()) return false;  // face (x, y, z) exists
-    }
-  }
-  const std::array<std::array<Index, 4>, 2> created = {{{x, y, z, u}, {y, x, z, v}}};
-  double old_min = 180;
-  for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
-  for (const auto& c : created)
-    if (!positive(c) || (!accept && quality_of(c) <= old_min + kImprovement)) return false;
-  if (accept) {
-    std::vector<std::array<Index, 4>> removed;
-    for (Index s : shell) removed.push_back(tet(s));
-    if (!accept(removed, {created.begin(), created.end()})) return false;
-  }
-  for (Index s : shell) kill_tet(s);
-  for (const auto& c : created) add_tet(c);
-  return true;
+  return remove_edge(u, v, 3, accept, 3);
 }
 
-bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& accept) {
+bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& accept, int min_ring) {
   const std::vector<Index> shell = tets_around_edge(u, v);
   const int n = static_cast<int>(shell.size());
-  if (n < 3 || n > max_ring) return false;
+  if (n < std::max(3, min_ring) || n > max_ring) return false;
   if (edge_kind(u, v) != EdgeKind::kInterior) return false;
   // The ring: for every tet {u, v, p, q} (an even permutation of its corners), q follows p.
   std::vector<std::pair<Index, Index>> links;

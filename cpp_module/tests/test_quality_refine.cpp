@@ -120,6 +120,16 @@ void edge_shell(SurfaceMesh& s, TetMesh& m, const std::vector<std::array<double,
   m.xyz = s.xyz;
 }
 
+// n ring points counter-clockwise around the z axis, at radius `even` for even k, `odd` for odd k.
+std::vector<std::array<double, 2>> ring_points(int n, double even, double odd) {
+  std::vector<std::array<double, 2>> out;
+  for (int k = 0; k < n; ++k) {
+    const double r = k % 2 ? odd : even;
+    out.push_back({r * std::cos(2 * k * M_PI / n), r * std::sin(2 * k * M_PI / n)});
+  }
+  return out;
+}
+
 double worst_angle(RefineMesh& r) {
   double w = 180;
   for (Index t = 0; t < r.num_tet_slots(); ++t)
@@ -132,11 +142,9 @@ double worst_angle(RefineMesh& r) {
 TEST(RefineMesh, EdgeRemovalReplacesTheShellByTheBestValidTriangulationOfItsRing) {
   // A hexagon around a long edge through a point near one ring corner: the wedges next to that
   // corner are slivers.
-  std::vector<std::array<double, 2>> hexagon;
-  for (int k = 0; k < 6; ++k) hexagon.push_back({std::cos(k * M_PI / 3), std::sin(k * M_PI / 3)});
   SurfaceMesh s;
   TetMesh m;
-  edge_shell(s, m, hexagon, {0.8, 0.05, 0.9}, {0.8, 0.05, -0.9});
+  edge_shell(s, m, ring_points(6, 1.0, 1.0), {0.8, 0.05, 0.9}, {0.8, 0.05, -0.9});
   ASSERT_TRUE(check_mesh(s, m).valid);
   RefineMesh r(s, m);
   const double before = worst_angle(r);
@@ -166,14 +174,9 @@ TEST(RefineMesh, EdgeRemovalOnANonConvexRingUsesOnlyDiagonalsInsideIt) {
   // A star-shaped, non-convex ring (radii alternating 1 and 0.35): the diagonals between its outer
   // corners pass outside it (at 0.5 from the axis), so every triangulation with one of them has a
   // negative tet; the best valid one (the inner triangle and three ears) raises the worst angle.
-  std::vector<std::array<double, 2>> star;
-  for (int k = 0; k < 6; ++k) {
-    const double r = k % 2 ? 0.35 : 1.0;
-    star.push_back({r * std::cos(k * M_PI / 3), r * std::sin(k * M_PI / 3)});
-  }
   SurfaceMesh s;
   TetMesh m;
-  edge_shell(s, m, star, {0.0, 0.0, 2.0}, {0.0, 0.0, -2.0});
+  edge_shell(s, m, ring_points(6, 1.0, 0.35), {0.0, 0.0, 2.0}, {0.0, 0.0, -2.0});
   ASSERT_TRUE(check_mesh(s, m).valid);
   RefineMesh r(s, m);
   const double before = worst_angle(r);

@@ -143,7 +143,8 @@ class RefineMesh {
   /// valid and it raises the smallest min dihedral of the tets involved; with `accept`, when
   /// valid and `accept` agrees (the angle test is then the caller's).
   bool flip23(Index t, int opposite, const TetsAccept& accept = {});
-  /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23.
+  /// 3-2 flip of the interior edge (u, v) with exactly three tets, same acceptance as flip23
+  /// (remove_edge on a ring of three).
   bool flip32(Index u, Index v, const TetsAccept& accept = {});
   /// Edge removal (Shewchuk's "n-to-2(n-2)" flip; flip32 is n = 3): the n tets around the interior
   /// edge (u, v), 3 <= n <= max_ring, are replaced by 2(n-2) tets: a triangulation of the ring of
@@ -155,8 +156,9 @@ class RefineMesh {
   /// caller's). Why the result is valid: the new tets are positive and, as a chain, have the same
   /// boundary as the old ones (the faces (u, w_i, w_i+1) and (v, w_i, w_i+1)), so they cover the
   /// old tets' union exactly once; the boundary of the solid is never touched (the edge is
-  /// interior, the ring faces stay).
-  bool remove_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {});
+  /// interior, the ring faces stay). Shells of fewer than `min_ring` tets are left (callers that
+  /// tried flip32 first pass 4).
+  bool remove_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {}, int min_ring = 3);
   /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
   /// tet `start` that never crosses a boundary face (kOutside when it would: p is outside the
   /// solid or on its boundary). The cavity is the tets whose circumsphere contains p (computed in
