@@ -147,6 +147,23 @@ def _effort(options):
     return {"steiner_effort": effort}
 
 
+BSP_SEEDS = ("auto", "delaunay", "box")
+
+
+def _native_core_options(options):
+    """Keywords for the native ``tetrahedralize``: ``steiner_effort`` and ``bsp_seed`` (absent:
+    the core's defaults)."""
+    from .errors import InputError
+
+    kw = _effort(options)
+    seed = options.get("bsp_seed")
+    if seed is not None:
+        if seed not in BSP_SEEDS:
+            raise InputError(f"bsp_seed must be one of {', '.join(BSP_SEEDS)}, got {seed!r}")
+        kw["bsp_seed"] = seed
+    return kw
+
+
 def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     """Tetrahedralizes the solid(s) bounded by ``surfaces`` (a Surface or a list, one per solid).
 
@@ -156,6 +173,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``steiner_effort`` (int:
     work (exact orientation tests, cavity growth) the core may spend removing one interior Steiner
     point, default 1000000; 0 = no bound: fewer interior Steiner points, possibly minutes more),
+    ``bsp_seed`` ("auto", the default, "delaunay" or "box": what the BSP starts from, see mesher.h
+    ``MeshOptions::seed``; ``stats["bsp_seed"]`` says which one the mesh came from),
     ``order`` (1 or 2),
     ``reorient`` (bool, default False: flip inconsistently oriented or inward-facing shells instead
     of refusing them, see :func:`check_surface`), ``max_memory`` (bytes or None: refuse, before
@@ -208,7 +227,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             points, tets, st = native.tetrahedralize(
                 surface.points, surface.triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
-                progress=report, cancel=cancel, **_effort(options))
+                progress=report, cancel=cancel, **_native_core_options(options))
         mesh = TetMesh(points, tets, surface.source)
         report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):
@@ -285,6 +304,8 @@ def _merge_stats(all_stats):
                 agg = out.setdefault(k, {})
                 for stage, value in v.items():
                     agg[stage] = agg.get(stage, 0) + value
+            elif isinstance(v, str):
+                out[k] = v if out.get(k, v) == v else "mixed"
             else:
                 out[k] = out.get(k, 0) + v
     qs = [st["quality"] for st in all_stats]
@@ -340,7 +361,7 @@ REFINE_OPTIONS = {
 
 #: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
 #: onto these, ``mesh_pipeline.CORE_OPTION_OF``).
-OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
+OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "bsp_seed", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
 
 
 def _positive_number(name, value, allow_zero=False):

@@ -148,11 +148,19 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "tetrahedralize",
       [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
-         py::object cancel, bool cone_cells, std::int64_t steiner_effort) {
+         py::object cancel, bool cone_cells, std::int64_t steiner_effort, const std::string& bsp_seed) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
         o.cone_cells = cone_cells;
+        if (bsp_seed == "auto")
+          o.seed = MeshOptions::Seed::kAuto;
+        else if (bsp_seed == "delaunay")
+          o.seed = MeshOptions::Seed::kDelaunay;
+        else if (bsp_seed == "box")
+          o.seed = MeshOptions::Seed::kBox;
+        else
+          throw py::value_error("bsp_seed must be 'auto', 'delaunay' or 'box', got '" + bsp_seed + "'");
         if (steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
         o.steiner_effort = steiner_effort;
         TetMesh mesh;
@@ -171,6 +179,11 @@ PYBIND11_MODULE(_bsptet, m) {
         d["convex_cells"] = st.convex_cells;
         d["inside_cells"] = st.inside_cells;
         d["bsp_points"] = st.bsp_points;
+        d["seed_tets"] = st.seed_tets;
+        d["seed_conflicts"] = st.seed_conflicts;
+        d["seed_fell_back"] = st.seed_fell_back;
+        d["seed_faces_relabelled"] = st.seed_faces_relabelled;
+        d["bsp_seed"] = st.delaunay_seeded ? "delaunay" : "box";  // what the mesh came from
         d["steiner_points_before_removal"] = st.steiner_before_removal;
         d["surface_steiner_points_before_removal"] = st.boundary_steiner_before_removal;
         d["collapsed"] = st.collapsed;
@@ -193,11 +206,15 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("cone_cells") = false,
       py::arg("steiner_effort") = MeshOptions{}.steiner_effort,
+      py::arg("bsp_seed") = "auto",
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
       "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison. "
       "steiner_effort: work (exact orientation tests, cavity growth) the core may spend removing one "
-      "interior Steiner point (0: no bound; MeshOptions::steiner_effort).");
+      "interior Steiner point (0: no bound; MeshOptions::steiner_effort). "
+      "bsp_seed: 'auto' (default), 'delaunay' (the BSP starts from the Delaunay tetrahedralization of "
+      "the input points) or 'box' (one box cell, the paper's auto-partition); MeshOptions::seed; "
+      "stats['bsp_seed'] says which one the mesh came from.");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.

@@ -11,7 +11,8 @@
 
 namespace bsptet {
 
-BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane)
+BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane,
+                       BspSeed seed)
     : geo_(geo), surface_(surface), tri_plane_(std::move(tri_plane)) {
   tri_box_.resize(static_cast<std::size_t>(surface_.num_triangles()));
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
@@ -21,7 +22,10 @@ BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::v
                    Interval(std::min({a.y, b.y, c.y}), std::max({a.y, b.y, c.y})),
                    Interval(std::min({a.z, b.z, c.z}), std::max({a.z, b.z, c.z}))};
   }
-  make_box();
+  if (seed == BspSeed::kDelaunay)
+    seed_delaunay();
+  else
+    make_box();
 }
 
 Index BspComplex::new_face(BspFace f) {
@@ -420,7 +424,8 @@ Index BspComplex::split_cell(Index c, Index p) {
 }
 
 void BspComplex::build(const std::function<bool()>& cancelled, const std::function<void(double)>& progress) {
-  std::vector<Index> work = {0};
+  std::vector<Index> work;  // every starting cell, the lowest id on top
+  for (std::size_t c = cells_.size(); c-- > 0;) work.push_back(static_cast<Index>(c));
   const double total = std::max<double>(1.0, static_cast<double>(surface_.num_triangles()));
   std::int64_t done_triangles = 0;
   while (!work.empty()) {

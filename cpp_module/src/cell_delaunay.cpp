@@ -123,13 +123,16 @@ class BowyerWatson {
         if (geo_.known_on_plane(p_[i], planes_[k])) mask_[i] |= std::uint64_t(1) << k;
   }
 
-  bool run(std::uint64_t seed) {
+  /// `shuffle`: insert in an order drawn from `seed`; otherwise in the order of the points (a
+  /// spatially sorted order keeps the walks short; the result is the same either way).
+  bool run(std::uint64_t seed, bool shuffle = true) {
     const int n = static_cast<int>(p_.size());
     if (n < 4) return false;
     std::vector<int> order(n);
     for (int i = 0; i < n; ++i) order[i] = i;
     std::uint64_t s = seed;
-    for (int i = n - 1; i > 0; --i) std::swap(order[i], order[static_cast<int>(splitmix(s) % (i + 1))]);
+    if (shuffle)
+      for (int i = n - 1; i > 0; --i) std::swap(order[i], order[static_cast<int>(splitmix(s) % (i + 1))]);
     rng_ = splitmix(s);
     // First tet: the first point, the next, the first not collinear, the first not coplanar.
     const int a = order[0], b = order[1];
@@ -402,6 +405,12 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
                    std::uint64_t seed, CellDelaunay& out) {
   BowyerWatson bw(geo, std::move(points), planes);
   if (!bw.run(seed)) return false;
+  return bw.collect(out);
+}
+
+bool delaunay_points(ImplicitGeometry& geo, std::vector<Index> points, CellDelaunay& out) {
+  BowyerWatson bw(geo, std::move(points), {});
+  if (!bw.run(0x5eedULL, false)) return false;
   return bw.collect(out);
 }
 

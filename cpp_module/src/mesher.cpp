@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <unordered_map>
@@ -160,7 +161,10 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
 
 void validate_surface(const SurfaceMesh& s) { validated_surface(s); }
 
-static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+// `seeded` (may be null) is set as soon as the complex exists: did this attempt use the Delaunay
+// seed (so that tetrahedralize knows what a failure means)?
+static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats,
+                                   bool* seeded = nullptr) {
   const auto t_start = Clock::now();
   MeshStats st;
   auto stage_time = [&](const char* name, Clock::time_point since) {
@@ -191,7 +195,21 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   stage_time("planes", t0);
 
   t0 = Clock::now();
-  BspComplex bsp(geo, surface, std::move(tri_plane));
+  using Seed = MeshOptions::Seed;
+  auto complex = std::make_unique<BspComplex>(geo, surface, tri_plane,
+                                              options.seed == Seed::kBox ? BspSeed::kBox : BspSeed::kDelaunay);
+  st.seed_tets = complex->stats().seed_tets;
+  st.seed_conflicts = complex->stats().seed_conflicts;
+  if (options.seed == Seed::kAuto &&
+      static_cast<double>(st.seed_conflicts) >
+          MeshOptions::kSeedConflictsPerTriangle * static_cast<double>(surface.num_triangles())) {
+    complex.reset();
+    complex = std::make_unique<BspComplex>(geo, surface, tri_plane, BspSeed::kBox);
+  }
+  st.delaunay_seeded = complex->stats().seed_tets > 0 ? 1 : 0;
+  st.seed_faces_relabelled = complex->stats().seed_faces_relabelled;
+  if (seeded) *seeded = st.delaunay_seeded != 0;
+  BspComplex& bsp = *complex;
   bsp.set_candidate_shift(options.bsp_candidate_shift);
   bsp.set_debug_checks(options.debug_checks);
   if (options.debug_checks) bsp.check_consistency();
@@ -248,7 +266,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   st.delaunay_cells = cell_tets.delaunay_cells;
   st.delaunay_recovered_cells = cell_tets.recovered_cells;
   st.delaunay_fallback_cells = cell_tets.delaunay_fallback_cells;
-  st.bsp_nodes = 2 * bsp.stats().splits + 1;
+  st.bsp_nodes = 2 * bsp.stats().splits + (st.delaunay_seeded ? bsp.stats().seed_tets : 1);
   st.convex_cells = bsp.stats().leaves;
   st.inside_cells = cell_tets.inside_cells;
   st.bsp_points = bsp.stats().bsp_points;
@@ -266,23 +284,35 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   // other partitions (BspComplex::set_candidate_shift 1, 2), each as valid as the first. Anything
   // else (bad input, cancelled, other stages) is reported as it is, and so is the last attempt's
   // failure.
+  // With the Delaunay seed, any internal failure or a contradiction in the inside/outside
+  // labels (which a face of the seed on an input plane that the seed did not recognise as such
+  // could cause, bsp_seed.cpp) is retried from the box, the paper's partition, with its own
+  // retries: an input the box meshes is never refused because of the seed.
+  using Seed = MeshOptions::Seed;
   std::vector<MeshOptions> attempts{options};
+  MeshOptions box = options;
+  box.seed = Seed::kBox;
+  if (options.seed != Seed::kBox) attempts.push_back(box);
   if (!options.covered_faces_along_lines) {
-    MeshOptions lines = options;
+    MeshOptions lines = box;
     lines.covered_faces_along_lines = true;
     attempts.push_back(lines);
   }
   for (std::size_t shift : {1, 2}) {
-    MeshOptions other = options;
+    MeshOptions other = box;
     other.bsp_candidate_shift = options.bsp_candidate_shift + shift;
     attempts.push_back(other);
   }
-  for (std::size_t k = 0;; ++k) {
+  bool first_seeded = false;
+  for (std::size_t k = 0; k < attempts.size(); ++k) {
+    bool seeded = false;
     try {
       MeshStats st;
-      TetMesh mesh = tetrahedralize_once(input, attempts[k], &st);
+      TetMesh mesh = tetrahedralize_once(input, attempts[k], &st, &seeded);
+      if (k == 0) first_seeded = seeded;
       if (k > 0) {
         st.retries = static_cast<std::int64_t>(k);
+        st.seed_fell_back = first_seeded ? 1 : 0;
         st.retried_along_lines = attempts[k].covered_faces_along_lines && !options.covered_faces_along_lines;
         st.bsp_candidate_shift = static_cast<std::int64_t>(attempts[k].bsp_candidate_shift);
         const double total = std::chrono::duration<double>(Clock::now() - t_start).count();
@@ -291,11 +321,21 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
       }
       if (stats) *stats = st;
       return mesh;
+    } catch (const InputError& e) {
+      if (k == 0) first_seeded = seeded;
+      if (k + 1 == attempts.size() || !seeded || e.stage() != "classify") throw;
+      if (options.progress) options.progress("retrying from the box: " + std::string(e.what()), 0);
     } catch (const MeshingError& e) {
-      if (k + 1 == attempts.size() || e.code() != ErrorCode::kInternal || e.stage() != "steiner") throw;
+      if (k == 0) first_seeded = seeded;
+      const bool retry = seeded ? e.code() == ErrorCode::kInternal
+                                : e.code() == ErrorCode::kInternal && e.stage() == "steiner";
+      if (k + 1 == attempts.size() || !retry) throw;
       if (options.progress) options.progress("retrying: " + std::string(e.what()), 0);
     }
+    // A first attempt that took the box by itself (kAuto) has just been the box attempt.
+    if (k == 0 && !seeded && options.seed != Seed::kBox) ++k;
   }
+  throw MeshingError(ErrorCode::kInternal, "mesher", -1, "no attempt left");  // not reached
 }
 
 }  // namespace bsptet

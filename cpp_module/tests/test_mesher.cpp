@@ -151,34 +151,42 @@ SurfaceMesh star_prism(int spikes, int k) {
 // against 3284 along whole lines, 3.1 per input triangle; 4 allowed), and the mesh is valid with no
 // surface Steiner point. (16 x 16, not run here: 8808 against 13448, 17 s against 308 s.)
 TEST(Mesher, ManyTrianglesOnOnePlaneStayLinear) {
-  for (const auto& [spikes, k] : {std::pair{5, 3}, std::pair{12, 8}}) {
-    const SurfaceMesh s = star_prism(spikes, k);
-    MeshOptions o;
-    o.debug_checks = spikes <= 5;
-    MeshStats st;
-    const TetMesh m = tetrahedralize(s, o, &st);
-    std::printf("star prism %d spikes, %d segments per side: %lld triangles, %lld BSP points, %lld Steiner points, "
-                "%lld tets\n",
-                spikes, k, (long long)st.input_triangles, (long long)st.bsp_points, (long long)st.steiner_points,
-                (long long)st.tets);
-    const MeshCheckReport r = check_mesh(s, m);
-    EXPECT_TRUE(r.valid);
-    for (const auto& msg : r.messages) ADD_FAILURE() << msg;
-    EXPECT_EQ(r.boundary_steiner_points, 0);
-    EXPECT_LE(st.bsp_points, 4 * st.input_triangles);
-    EXPECT_EQ(st.retried_along_lines, 0);
-    // The earlier refinement along whole edge lines (the fallback when the Steiner removal gets
-    // stuck) is valid too, with more BSP points on the fanned caps.
-    o.covered_faces_along_lines = true;
-    MeshStats lines;
-    const TetMesh ml = tetrahedralize(s, o, &lines);
-    std::printf("  along whole lines: %lld BSP points, %lld Steiner points, %lld tets\n", (long long)lines.bsp_points,
-                (long long)lines.steiner_points, (long long)lines.tets);
-    const MeshCheckReport rl = check_mesh(s, ml);
-    EXPECT_TRUE(rl.valid);
-    EXPECT_EQ(rl.boundary_steiner_points, 0);
-    EXPECT_GT(lines.bsp_points, st.bsp_points);
-  }
+  // Both starts of the BSP: the box (the paper's partition; its covered faces refined per input
+  // triangle) and the Delaunay seed (the fanned caps' long triangles cross many seed tets).
+  for (const auto seed : {MeshOptions::Seed::kBox, MeshOptions::Seed::kDelaunay})
+    for (const auto& [spikes, k] : {std::pair{5, 3}, std::pair{12, 8}}) {
+      const bool box = seed == MeshOptions::Seed::kBox;
+      const SurfaceMesh s = star_prism(spikes, k);
+      MeshOptions o;
+      o.seed = seed;
+      o.debug_checks = spikes <= 5;
+      MeshStats st;
+      const TetMesh m = tetrahedralize(s, o, &st);
+      std::printf("%s: star prism %d spikes, %d segments per side: %lld triangles, %lld BSP points, %lld Steiner "
+                  "points, %lld tets\n",
+                  box ? "box" : "Delaunay seed", spikes, k, (long long)st.input_triangles, (long long)st.bsp_points,
+                  (long long)st.steiner_points, (long long)st.tets);
+      const MeshCheckReport r = check_mesh(s, m);
+      EXPECT_TRUE(r.valid);
+      for (const auto& msg : r.messages) ADD_FAILURE() << msg;
+      EXPECT_EQ(r.boundary_steiner_points, 0);
+      EXPECT_EQ(st.delaunay_seeded, box ? 0 : 1);
+      EXPECT_LE(st.bsp_points, (box ? 4 : 5) * st.input_triangles);
+      EXPECT_EQ(st.retried_along_lines, 0);
+      EXPECT_EQ(st.seed_fell_back, 0);
+      if (!box) continue;
+      // The earlier refinement along whole edge lines (the fallback when the Steiner removal gets
+      // stuck) is valid too, with more BSP points on the fanned caps.
+      o.covered_faces_along_lines = true;
+      MeshStats lines;
+      const TetMesh ml = tetrahedralize(s, o, &lines);
+      std::printf("  along whole lines: %lld BSP points, %lld Steiner points, %lld tets\n", (long long)lines.bsp_points,
+                  (long long)lines.steiner_points, (long long)lines.tets);
+      const MeshCheckReport rl = check_mesh(s, ml);
+      EXPECT_TRUE(rl.valid);
+      EXPECT_EQ(rl.boundary_steiner_points, 0);
+      EXPECT_GT(lines.bsp_points, st.bsp_points);
+    }
 }
 
 // The effort bound of the optional Steiner removal phases (MeshOptions::steiner_effort): with

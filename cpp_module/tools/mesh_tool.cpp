@@ -1,7 +1,7 @@
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //
-//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--reorient]
+//   bsptet_mesh SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--seed auto|delaunay|box] [--along-lines] [--reorient]
 //               [--progress] [--write STEM]
 //
 // --bsp-shift K: score the BSP's sampled candidate planes shifted by K (another partition; what the
@@ -12,6 +12,7 @@
 //   tetrahedralize() uses by itself when the Steiner removal gets stuck).
 // --progress: print each stage and its percentage to stderr as it goes.
 // --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
+// --seed: what the BSP starts from (MeshOptions::seed; default auto).
 //
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
 // shells facing the wrong way); --reorient flips triangles as that check allows.
@@ -33,7 +34,7 @@ using namespace bsptet;
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
+                 "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--seed auto|delaunay|box] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
                  "[--progress] [--write STEM]\n",
                  argv[0]);
     return 2;
@@ -45,6 +46,16 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
     else if (!std::strcmp(argv[i], "--cone-cells")) o.cone_cells = true;
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
+      const std::string m = argv[++i];
+      if (m == "auto") o.seed = MeshOptions::Seed::kAuto;
+      else if (m == "delaunay") o.seed = MeshOptions::Seed::kDelaunay;
+      else if (m == "box") o.seed = MeshOptions::Seed::kBox;
+      else {
+        std::fprintf(stderr, "--seed: auto, delaunay or box, got %s\n", m.c_str());
+        return 2;
+      }
+    }
     else if (!std::strcmp(argv[i], "--along-lines")) o.covered_faces_along_lines = true;
     else if (!std::strcmp(argv[i], "--bsp-shift") && i + 1 < argc) o.bsp_candidate_shift = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--steiner-effort") && i + 1 < argc) o.steiner_effort = std::strtoll(argv[++i], nullptr, 10);
@@ -82,6 +93,11 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.bsp_points), st.seconds_total, r.quality.min_dihedral_deg,
                 st.retried_along_lines ? " (retried along lines)" : "",
                 st.bsp_candidate_shift ? (" (retried with BSP candidate shift " + std::to_string(st.bsp_candidate_shift) + ")").c_str() : "");
+    if (st.seed_tets > 0 || st.seed_fell_back)
+      std::printf("  seed: tets %lld conflicts %lld relabelled faces %lld used %lld fell_back %lld\n",
+                  static_cast<long long>(st.seed_tets), static_cast<long long>(st.seed_conflicts),
+                  static_cast<long long>(st.seed_faces_relabelled), static_cast<long long>(st.delaunay_seeded),
+                  static_cast<long long>(st.seed_fell_back));
     for (const auto& [stage, sec] : st.seconds_by_stage) std::printf("  %s %.3f", stage.c_str(), sec);
     std::printf("\n  steiner removal:");
     for (const auto& [phase, sec] : st.steiner_seconds_by_phase)

@@ -86,7 +86,15 @@ struct BspCell {
   bool alive = true;
 };
 
+/// What the complex starts from: one box cell (the paper: every input plane may cut it), or the
+/// tets of the Delaunay tetrahedralization of the input points and the box corners (bsp_seed.cpp:
+/// only the cells an input triangle actually crosses are split).
+enum class BspSeed { kBox, kDelaunay };
+
 struct BspStats {
+  std::int64_t seed_tets = 0;       ///< cells the complex started from beside the box (BspSeed::kDelaunay)
+  std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs after seeding
+  std::int64_t seed_faces_relabelled = 0;  ///< seed faces found on an input plane only by the walk
   std::int64_t splits = 0;          ///< internal BSP nodes
   std::int64_t leaves = 0;          ///< convex cells
   std::int64_t bsp_points = 0;      ///< vertices created by splits (TPI points)
@@ -101,7 +109,9 @@ class BspComplex {
 
   /// `geo` holds the input points as explicit points 0..#P-1 with vertices of the same ids, and
   /// the planes; `tri_plane[t]` is the plane of input triangle t.
-  BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane);
+  /// `seed`: see BspSeed (kDelaunay also needs the box corners as the last 8 explicit points).
+  BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane,
+             BspSeed seed = BspSeed::kBox);
   /// Which sampled candidates choose_plane scores: the i-th is the conflict list's entry
   /// (i * n / ncand + candidate_shift) mod n. 0 (the default) is the paper's sampling; another
   /// value gives another, equally valid partition (the mesher's last retry).
@@ -156,6 +166,9 @@ class BspComplex {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
   }
   void make_box();
+  /// bsp_seed.cpp: the cells are the Delaunay tets of the used input points and the box corners;
+  /// conflict lists by a walk and a separating-axis test per input triangle.
+  void seed_delaunay();
   Index new_face(BspFace f);
   void register_edges(Index f);
   void unregister_edges(Index f);

@@ -53,6 +53,8 @@ class ImplicitGeometry {
   /// ZERO without arithmetic.
   void note_on_plane(Index v, Index p);
 
+  /// The planes v is known to lie on (its TPI planes, its triangles' planes, cut planes).
+  const std::vector<Index>& known_planes(Index v) const { return verts_[v].on_planes; }
   bool is_explicit(Index v) const { return verts_[v].explicit_id >= 0; }
   Index explicit_id(Index v) const { return verts_[v].explicit_id; }
   const std::array<Index, 3>& tpi_planes(Index v) const { return verts_[v].planes; }

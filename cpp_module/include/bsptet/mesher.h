@@ -35,6 +35,15 @@ struct MeshOptions {
   /// 6; bsp_complex.h refine_covered_faces_along_lines) instead of one piece per input triangle.
   /// tetrahedralize() retries with it by itself when the Steiner removal gets stuck.
   bool covered_faces_along_lines = false;
+  /// What the BSP starts from (bsp_complex.h BspSeed): kDelaunay, the Delaunay tetrahedralization
+  /// of the input points (only the cells an input triangle crosses are split: far fewer BSP points
+  /// on fine smooth surfaces); kBox, one box cell (the paper's auto-partition); kAuto (default),
+  /// the Delaunay seed unless the input triangles cross more than kSeedConflictsPerTriangle of its
+  /// tets per triangle on average (long thin triangles across many tets: there the box's
+  /// partition is cheaper), then the box. Same kind of output either way (exact, checked).
+  enum class Seed { kAuto, kDelaunay, kBox };
+  Seed seed = Seed::kAuto;
+  static constexpr double kSeedConflictsPerTriangle = 4.0;
   /// BspComplex::set_candidate_shift for the BSP's plane choice (0: the paper's sampling).
   std::size_t bsp_candidate_shift = 0;
   /// SteinerRemovalOptions::interior_work_per_point: how hard the core tries to remove one interior
@@ -52,6 +61,11 @@ struct MeshStats {
   std::int64_t input_points = 0, input_triangles = 0, input_planes = 0;
   std::int64_t points = 0, tets = 0, steiner_points = 0, boundary_steiner_points = 0;
   std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
+  std::int64_t delaunay_seeded = 0;  ///< 1 when the mesh was made from the Delaunay seed
+  std::int64_t seed_tets = 0;  ///< cells of the Delaunay seed (also when kAuto then took the box)
+  std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs (BspStats)
+  std::int64_t seed_faces_relabelled = 0;  ///< seed faces given their input plane by the walk (BspStats)
+  std::int64_t seed_fell_back = 0;  ///< the seeded attempt failed and the box meshed (tetrahedralize's retries)
   std::int64_t steiner_before_removal = 0, boundary_steiner_before_removal = 0, collapsed = 0, relocated = 0, pushed = 0;
   std::int64_t apex_cells = 0, pulled_cells = 0;
   std::int64_t delaunay_cells = 0, delaunay_recovered_cells = 0, delaunay_fallback_cells = 0;  ///< CellTets

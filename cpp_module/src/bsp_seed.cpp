@@ -1,0 +1,329 @@
+// FemBspTet core: seeding the BSP complex with a Delaunay tetrahedralization of the input points
+// (issue 8; the idea of Diazzi & Attene's BSP complex, 2021), see bsp_complex.h.
+//
+// Instead of one box cell cut by every input plane, the complex starts as the tets of the exact
+// (perturbed) Delaunay tetrahedralization of the input points and the 8 box corners. Each tet is a
+// convex cell; its conflict list holds the input triangles that may cross its interior, found by
+// a walk from the triangle's first vertex and decided by a separating-axis test (exact on the
+// face planes, certified intervals on the edge-pair axes; conservative: a triangle is left out
+// only when the interiors are proved disjoint). The build then splits only those cells, by the
+// planes of their conflict triangles, as with the box. On a fine surface most input triangles
+// are Delaunay faces already and cut nothing: the cells, BSP points and Steiner points no longer
+// grow with the number of planes a cell sees (the auto-partition's peeling chain).
+//
+// Faces of the seed lie on an input plane when their three corners do (known from the input
+// triangles around each corner, or decided exactly against the planes of any corner's
+// triangles); such a face takes that plane's id and lists the plane's triangles that may overlap
+// it (`coplanar`), so that refine_covered_faces and the classification see it as with the box.
+// Any other face gets a plane of its own through its three corners; the walk of step 3 gives it
+// an input plane after all when it lies on the plane of a triangle that touches it (its corners
+// may lie on an input plane without being corners of that plane's triangles).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "bsptet/bsp_complex.h"
+#include "bsptet/cell_delaunay.h"
+#include "bsptet/errors.h"
+#include "bsptet/predicates.h"
+
+namespace bsptet {
+
+namespace {
+
+// Face opposite vertex i, ordered so that vertex i lies on its positive side (orient3d > 0 for a
+// positive tet), as in cell_delaunay.cpp.
+constexpr int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+std::uint64_t spread3(std::uint64_t x) {  // 21 bits -> every third bit of 63
+  x &= 0x1fffffULL;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+// p . n with a bound on its rounding error: the exact value lies in [d - err, d + err]
+// (|fl(dot3) - dot3| <= gamma_3 sum |p_i n_i|, gamma_3 < 4u; plus underflow).
+void dot_bounds(const Vec3& p, const Vec3& n, double& lo, double& hi) {
+  const double a = p.x * n.x, b = p.y * n.y, c = p.z * n.z;
+  const double d = a + b + c;
+  const double err = (std::fabs(a) + std::fabs(b) + std::fabs(c)) * (4.0 * 0x1p-53) + 0x1p-1020;
+  lo = d - err;
+  hi = d + err;
+}
+
+// How a tet (positive, corners p) and a triangle (q) meet: 0 when the closed sets are proved
+// disjoint, 1 when their interiors are proved disjoint (they may touch), 2 otherwise (the triangle
+// may cross the tet's interior). Separating axes: the tet's face planes and the triangle's plane
+// (exact orient3d), then the 18 edge-pair directions (rounded, with certified bounds on the
+// projections: any direction proves a separation its projections show). `share_vertex`: the two
+// have a common corner (so they touch).
+int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 4>& pid, const std::array<Vec3, 3>& q,
+                          const std::array<Index, 3>& qid) {
+  bool share_vertex = false;
+  for (Index a : pid)
+    for (Index b : qid) share_vertex = share_vertex || a == b;
+  // Bounding boxes (exact comparisons of doubles).
+  for (int k = 0; k < 3; ++k) {
+    auto coord = [k](const Vec3& x) { return k == 0 ? x.x : (k == 1 ? x.y : x.z); };
+    double plo = INFINITY, phi = -INFINITY, qlo = INFINITY, qhi = -INFINITY;
+    for (const Vec3& x : p) {
+      plo = std::min(plo, coord(x));
+      phi = std::max(phi, coord(x));
+    }
+    for (const Vec3& x : q) {
+      qlo = std::min(qlo, coord(x));
+      qhi = std::max(qhi, coord(x));
+    }
+    if (phi < qlo || qhi < plo) return 0;
+  }
+  bool weak = false;
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 &a = p[kFace[i][0]], &b = p[kFace[i][1]], &c = p[kFace[i][2]];
+    int mx = -1;
+    for (int k = 0; k < 3; ++k) {
+      // A corner of the face is on its plane: no arithmetic (an exact zero is the slow case).
+      const bool corner = qid[k] == pid[kFace[i][0]] || qid[k] == pid[kFace[i][1]] || qid[k] == pid[kFace[i][2]];
+      mx = std::max(mx, corner ? 0 : to_int(orient3d(a, b, c, q[k])));
+      if (mx > 0) break;
+    }
+    if (mx < 0) return 0;
+    if (mx == 0) weak = true;
+  }
+  {
+    int mn = 1, mx = -1;
+    for (int j = 0; j < 4; ++j) {
+      const bool corner = pid[j] == qid[0] || pid[j] == qid[1] || pid[j] == qid[2];
+      const int s = corner ? 0 : to_int(orient3d(q[0], q[1], q[2], p[j]));
+      mn = std::min(mn, s);
+      mx = std::max(mx, s);
+    }
+    if (mn > 0 || mx < 0) return 0;
+    if (mn >= 0 || mx <= 0) weak = true;
+  }
+  // Touching at a common vertex: never strictly apart, so nothing more to learn.
+  if (weak && share_vertex) return 1;
+  for (const auto& e : kEdge) {
+    const Vec3 u{p[e[1]].x - p[e[0]].x, p[e[1]].y - p[e[0]].y, p[e[1]].z - p[e[0]].z};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 &f0 = q[k], &f1 = q[(k + 1) % 3];
+      const Vec3 v{f1.x - f0.x, f1.y - f0.y, f1.z - f0.z};
+      const Vec3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+      if (n.x == 0 && n.y == 0 && n.z == 0) continue;
+      double tlo = INFINITY, thi = -INFINITY, qlo = INFINITY, qhi = -INFINITY;
+      for (const Vec3& x : p) {
+        double lo, hi;
+        dot_bounds(x, n, lo, hi);
+        tlo = std::min(tlo, lo);
+        thi = std::max(thi, hi);
+      }
+      for (const Vec3& x : q) {
+        double lo, hi;
+        dot_bounds(x, n, lo, hi);
+        qlo = std::min(qlo, lo);
+        qhi = std::max(qhi, hi);
+      }
+      if (!(std::isfinite(tlo) && std::isfinite(thi) && std::isfinite(qlo) && std::isfinite(qhi))) continue;
+      if (thi < qlo || qhi < tlo) return 0;
+      if (thi <= qlo || qhi <= tlo) weak = true;
+    }
+  }
+  return weak ? 1 : 2;
+}
+
+}  // namespace
+
+void BspComplex::seed_delaunay() {
+  corner0_ = geo_.num_explicit() - 8;
+  const Index input_planes = geo_.num_planes();
+  // Vertex ids of explicit points are their point ids here (mesher.cpp adds them in order).
+  auto point_of = [&](Index v) -> const Vec3& { return geo_.explicit_point(geo_.explicit_id(v)); };
+  // 1. The points: the box corners first (their hull is the box, so every walk stays inside),
+  // then the input points that triangles use, in Morton order of their coordinates (short walks).
+  std::vector<char> used(static_cast<std::size_t>(corner0_), 0);
+  for (Index v : surface_.tri) used[v] = 1;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (Index c = corner0_; c < corner0_ + 8; ++c) {
+    const Vec3& x = point_of(c);
+    const double xs[3] = {x.x, x.y, x.z};
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], xs[k]);
+      hi[k] = std::max(hi[k], xs[k]);
+    }
+  }
+  std::vector<std::pair<std::uint64_t, Index>> keyed;
+  for (Index v = 0; v < corner0_; ++v) {
+    if (!used[v]) continue;
+    const Vec3& x = point_of(v);
+    const double xs[3] = {x.x, x.y, x.z};
+    std::uint64_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double f = (xs[k] - lo[k]) / (hi[k] - lo[k]);
+      const auto g = static_cast<std::uint64_t>(std::clamp(f, 0.0, 1.0) * 2097151.0);
+      code |= spread3(g) << k;
+    }
+    keyed.push_back({code, v});
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<Index> order;
+  order.reserve(keyed.size() + 8);
+  for (Index c = corner0_; c < corner0_ + 8; ++c) order.push_back(c);
+  for (const auto& kv : keyed) order.push_back(kv.second);
+  CellDelaunay dt;
+  if (!delaunay_points(geo_, std::move(order), dt))
+    throw MeshingError(ErrorCode::kInternal, "bsp", -1, "the Delaunay seed of the input points failed");
+  const std::vector<std::array<Index, 4>>& tets = dt.tets;
+  const Index nt = static_cast<Index>(tets.size());
+  stats_.seed_tets = nt;
+
+  // 2. Faces: one per distinct triangle of the tets, shared by its (one or two) tets.
+  struct Slot {
+    std::array<Index, 3> key;
+    Index tet;
+    int i;
+  };
+  std::vector<Slot> slots;
+  slots.reserve(4 * static_cast<std::size_t>(nt));
+  for (Index t = 0; t < nt; ++t)
+    for (int i = 0; i < 4; ++i) {
+      std::array<Index, 3> key{{tets[t][kFace[i][0]], tets[t][kFace[i][1]], tets[t][kFace[i][2]]}};
+      std::sort(key.begin(), key.end());
+      slots.push_back({key, t, i});
+    }
+  std::sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
+    return a.key != b.key ? a.key < b.key : (a.tet != b.tet ? a.tet < b.tet : a.i < b.i);
+  });
+  cells_.assign(static_cast<std::size_t>(nt), BspCell{});
+  std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1}), nb(nt, {-1, -1, -1, -1});
+  auto input_plane_of = [&](Index x, Index y, Index z) -> Index {
+    for (Index w : {x, y, z}) {
+      if (w >= corner0_) continue;
+      const std::vector<Index> planes = geo_.known_planes(w);  // copy: side() may note planes
+      for (Index q : planes) {
+        if (q >= input_planes) continue;
+        bool on = true;
+        for (Index o : {x, y, z})
+          if (o != w && !geo_.known_on_plane(o, q) && geo_.side(q, o) != Sign::kZero) on = false;
+        if (on) return q;
+      }
+    }
+    return -1;
+  };
+  for (std::size_t s = 0; s < slots.size();) {
+    std::size_t e = s + 1;
+    while (e < slots.size() && slots[e].key == slots[s].key) ++e;
+    if (e - s > 2) throw MeshingError(ErrorCode::kInternal, "bsp", -1, "a Delaunay seed face has more than two tets");
+    const Index t0 = slots[s].tet, t1 = e - s == 2 ? slots[s + 1].tet : -1;
+    const int i0 = slots[s].i;
+    const Index x = tets[t0][kFace[i0][0]], y = tets[t0][kFace[i0][1]], z = tets[t0][kFace[i0][2]];
+    const Index apex = tets[t0][i0];  // on the positive side of (x, y, z)
+    BspFace f;
+    const Index q = input_plane_of(x, y, z);
+    if (q >= 0) {
+      f.plane = q;
+      const Sign side = geo_.side(q, apex);
+      if (side == Sign::kZero) throw MeshingError(ErrorCode::kInternal, "bsp", t0, "a flat Delaunay seed tet");
+      if (side == Sign::kPositive) {
+        f.verts = {x, y, z};
+        f.cell[0] = t0;
+        f.cell[1] = t1;
+      } else {
+        f.verts = {x, z, y};
+        f.cell[0] = t1;
+        f.cell[1] = t0;
+      }
+    } else {
+      f.plane = geo_.add_plane(geo_.explicit_id(x), geo_.explicit_id(y), geo_.explicit_id(z));
+      f.verts = {x, y, z};
+      f.cell[0] = t0;
+      f.cell[1] = t1;
+    }
+    const Index id = new_face(std::move(f));
+    tet_face[t0][i0] = id;
+    if (t1 >= 0) {
+      tet_face[t1][slots[s + 1].i] = id;
+      nb[t0][i0] = t1;
+      nb[t1][slots[s + 1].i] = t0;
+    }
+    s = e;
+  }
+  std::vector<Index> vertex_tet(static_cast<std::size_t>(corner0_ + 8), -1);
+  for (Index t = 0; t < nt; ++t) {
+    for (int i = 0; i < 4; ++i) {
+      cells_[t].faces.push_back(tet_face[t][i]);
+      cells_[t].boxes.push_back(face_box(tet_face[t][i]));
+      if (vertex_tet[tets[t][i]] < 0) vertex_tet[tets[t][i]] = t;
+    }
+  }
+
+  // 3. Conflict lists and coplanar lists, by a walk over the tets each triangle meets.
+  std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
+  std::uint32_t stamp = 0;
+  std::vector<Index> queue;
+  for (Index tr = 0; tr < surface_.num_triangles(); ++tr) {
+    const std::array<Vec3, 3> q{{surface_.point(triangle_vertex(tr, 0)), surface_.point(triangle_vertex(tr, 1)),
+                                 surface_.point(triangle_vertex(tr, 2))}};
+    const std::array<Index, 3> qid{{triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2)}};
+    const Index plane = tri_plane_[tr];
+    ++stamp;
+    queue.clear();
+    const Index start = vertex_tet[triangle_vertex(tr, 0)];
+    if (start < 0) throw MeshingError(ErrorCode::kInternal, "bsp", tr, "an input vertex is not in the Delaunay seed");
+    queue.push_back(start);
+    seen[start] = stamp;
+    for (std::size_t h = 0; h < queue.size(); ++h) {
+      const Index t = queue[h];
+      const std::array<Vec3, 4> p{{point_of(tets[t][0]), point_of(tets[t][1]), point_of(tets[t][2]),
+                                   point_of(tets[t][3])}};
+      const int rel = tet_triangle_relation(p, tets[t], q, qid);
+      if (rel == 0) continue;
+      if (rel == 2) {
+        cells_[t].conflict.push_back(tr);
+        ++stats_.seed_conflicts;
+      }
+      for (int i = 0; i < 4; ++i) {
+        BspFace& f = faces_[tet_face[t][i]];
+        // A face given a plane of its own may still lie on this triangle's plane (none of its
+        // corners is a corner of that plane's triangles, step 2): then it takes the input plane,
+        // decided exactly, so that the coverage and the classification see it.
+        if (f.plane >= input_planes && (!f.box.ok || geo_.side_of_box(plane, f.box.box) == Sign::kZero) &&
+            std::all_of(f.verts.begin(), f.verts.end(), [&](Index v) { return geo_.side(plane, v) == Sign::kZero; })) {
+          const Sign apex_side = geo_.side(plane, tets[t][i]);
+          if (apex_side == Sign::kZero) throw MeshingError(ErrorCode::kInternal, "bsp", t, "a flat Delaunay seed tet");
+          if ((f.cell[0] == t) != (apex_side == Sign::kPositive)) {
+            std::reverse(f.verts.begin(), f.verts.end());
+            std::swap(f.cell[0], f.cell[1]);
+          }
+          f.plane = plane;
+          ++stats_.seed_faces_relabelled;
+        }
+        if (f.plane == plane && (f.coplanar.empty() || f.coplanar.back() != tr)) f.coplanar.push_back(tr);
+        const Index n = nb[t][i];
+        if (n >= 0 && seen[n] != stamp) {
+          seen[n] = stamp;
+          queue.push_back(n);
+        }
+      }
+    }
+  }
+  // 4. Edge lines: the planes of the two faces of a tet through the edge (never the same
+  // geometric plane), taken after the walk, which may have given faces their input plane.
+  for (Index t = 0; t < nt; ++t) {
+    for (const auto& ed : kEdge) {
+      const std::uint64_t key = edge_key(tets[t][ed[0]], tets[t][ed[1]]);
+      if (edge_line_.count(key)) continue;
+      int other[2], m = 0;
+      for (int j = 0; j < 4; ++j)
+        if (j != ed[0] && j != ed[1]) other[m++] = j;
+      edge_line_[key] = {faces_[tet_face[t][other[0]]].plane, faces_[tet_face[t][other[1]]].plane};
+    }
+  }
+}
+
+}  // namespace bsptet
