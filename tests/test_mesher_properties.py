@@ -119,3 +119,98 @@ def test_twisted_prisms(n, twist):
     s = twisted_prism(n, twist)
     assert core.signed_volume(s) > 0
     _mesh_and_check(s, f"twisted prism n={n} twist={twist}")
+
+
+def mesh_volume(mesh):
+    p = mesh.points[mesh.tets[:, :4]]
+    return float(np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])).sum() / 6)
+
+
+def union_of_voxels(rng, shape=(4, 4, 3), fill=0.6):
+    """A random union of unit cubes on an integer grid (the largest face-connected set of the
+    filled cells), its boundary squares split into two triangles along a random diagonal, or None
+    when that surface is not a closed manifold (cells meeting only along an edge or at a corner).
+    Integer coordinates: every vertex lies on many input planes and on the planes of faces it is
+    not a corner of, the degenerate ground of the BSP (T-junction-free, cospherical, coplanar)."""
+    filled = rng.random(shape) < fill
+    # The largest face-connected component.
+    label = -np.ones(shape, dtype=int)
+    best, best_size = -1, 0
+    for start in zip(*np.nonzero(filled)):
+        if label[start] >= 0:
+            continue
+        k = int(label.max()) + 1
+        stack, size = [start], 0
+        label[start] = k
+        while stack:
+            c = stack.pop()
+            size += 1
+            for axis in range(3):
+                for step in (-1, 1):
+                    n = list(c)
+                    n[axis] += step
+                    n = tuple(n)
+                    if all(0 <= n[i] < shape[i] for i in range(3)) and filled[n] and label[n] < 0:
+                        label[n] = k
+                        stack.append(n)
+        if size > best_size:
+            best, best_size = k, size
+    cells = label == best
+    index = {}
+    points, tris = [], []
+
+    def vid(p):
+        if p not in index:
+            index[p] = len(points)
+            points.append(p)
+        return index[p]
+
+    for c in zip(*np.nonzero(cells)):
+        for axis in range(3):
+            for step in (-1, 1):
+                n = list(c)
+                n[axis] += step
+                if all(0 <= n[i] < shape[i] for i in range(3)) and cells[tuple(n)]:
+                    continue
+                u, v = (axis + 1) % 3, (axis + 2) % 3
+                base = list(c)
+                if step > 0:
+                    base[axis] += 1
+                quad = []
+                for du, dv in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                    p = list(base)
+                    p[u] += du
+                    p[v] += dv
+                    quad.append(vid(tuple(float(x) for x in p)))
+                if step < 0:
+                    quad.reverse()  # (u, v, axis) is right-handed: CCW seen from +axis
+                a, b, cc, d = quad
+                if rng.random() < 0.5:
+                    tris += [(a, b, cc), (a, cc, d)]
+                else:
+                    tris += [(a, b, d), (b, cc, d)]
+    s = Surface(np.array(points, dtype=float), np.array(tris, dtype=np.int64))
+    try:
+        core.check_surface(s)
+    except Exception:
+        return None
+    return s
+
+
+@pytest.mark.parametrize("seed", range(71, 79))
+@pytest.mark.parametrize("bsp_seed", ["delaunay", "box"])
+def test_random_unions_of_voxels(seed, bsp_seed):
+    """Both starts of the BSP (the Delaunay seed, the box) on random unions of unit cubes: valid,
+    the surface kept, and the seeded run made from the seed (no fallback to the box)."""
+    rng = np.random.default_rng(seed)
+    s = None
+    while s is None:
+        s = union_of_voxels(rng)
+    print(f"seed {seed} bsp_seed {bsp_seed}: {len(s.points)} points, {len(s.triangles)} triangles")
+    mesh, stats = core.tetrahedralize(s, {"bsp_seed": bsp_seed})
+    report = core.check_mesh(s, mesh)
+    assert report["valid"], f"voxels seed {seed}: " + "; ".join(report["messages"])
+    assert report["boundary_steiner_points"] == 0
+    assert stats["bsp_seed"] == bsp_seed
+    assert stats["retries"] == 0
+    assert abs(mesh_volume(mesh) - core.signed_volume(s)) <= 1e-12 * core.signed_volume(s)
