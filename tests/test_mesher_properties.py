@@ -214,3 +214,20 @@ def test_random_unions_of_voxels(seed, bsp_seed):
     assert stats["bsp_seed"] == bsp_seed
     assert stats["retries"] == 0
     assert abs(mesh_volume(mesh) - core.signed_volume(s)) <= 1e-12 * core.signed_volume(s)
+
+
+def test_auto_seed_takes_the_box_when_triangles_cross_many_seed_tets():
+    """``joint``'s long triangles cross many tets of the Delaunay seed: "auto" stops its walks as
+    soon as the crossings pass 4 per input triangle and meshes from the box; forcing the seed
+    still gives a valid mesh."""
+    s = read_surface(corpus_path("joint"))
+    bound = int(4 * len(s.triangles))
+    mesh, stats = core.tetrahedralize(s)
+    assert stats["bsp_seed"] == "box"
+    assert stats["seed_conflicts"] == bound + 1  # counted up to the bound, then abandoned
+    assert core.check_mesh(s, mesh)["valid"]
+    forced, fst = core.tetrahedralize(s, {"bsp_seed": "delaunay"})
+    assert fst["bsp_seed"] == "delaunay" and fst["seed_conflicts"] > bound
+    report = core.check_mesh(s, forced)
+    assert report["valid"], "; ".join(report["messages"])
+    assert report["boundary_steiner_points"] == 0

@@ -12,7 +12,7 @@
 namespace bsptet {
 
 BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane,
-                       BspSeed seed)
+                       BspSeed seed, std::int64_t max_seed_conflicts)
     : geo_(geo), surface_(surface), tri_plane_(std::move(tri_plane)) {
   tri_box_.resize(static_cast<std::size_t>(surface_.num_triangles()));
   for (Index t = 0; t < surface_.num_triangles(); ++t) {
@@ -23,7 +23,7 @@ BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::v
                    Interval(std::min({a.z, b.z, c.z}), std::max({a.z, b.z, c.z}))};
   }
   if (seed == BspSeed::kDelaunay)
-    seed_delaunay();
+    seed_delaunay(max_seed_conflicts);
   else
     make_box();
 }

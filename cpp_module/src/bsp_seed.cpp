@@ -139,7 +139,7 @@ int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 
 
 }  // namespace
 
-void BspComplex::seed_delaunay() {
+void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   corner0_ = geo_.num_explicit() - 8;
   const Index input_planes = geo_.num_planes();
   // Vertex ids of explicit points are their point ids here (mesher.cpp adds them in order).
@@ -285,7 +285,10 @@ void BspComplex::seed_delaunay() {
       if (rel == 0) continue;
       if (rel == 2) {
         cells_[t].conflict.push_back(tr);
-        ++stats_.seed_conflicts;
+        if (++stats_.seed_conflicts > max_conflicts && max_conflicts >= 0) {
+          stats_.seed_abandoned = true;
+          return;
+        }
       }
       for (int i = 0; i < 4; ++i) {
         BspFace& f = faces_[tet_face[t][i]];

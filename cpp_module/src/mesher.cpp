@@ -196,13 +196,17 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
 
   t0 = Clock::now();
   using Seed = MeshOptions::Seed;
+  // kAuto: the walks stop as soon as the conflicts pass the bound (then the box is cheaper).
+  const std::int64_t max_seed_conflicts =
+      options.seed == Seed::kAuto
+          ? static_cast<std::int64_t>(MeshOptions::kSeedConflictsPerTriangle * static_cast<double>(surface.num_triangles()))
+          : -1;
   auto complex = std::make_unique<BspComplex>(geo, surface, tri_plane,
-                                              options.seed == Seed::kBox ? BspSeed::kBox : BspSeed::kDelaunay);
+                                              options.seed == Seed::kBox ? BspSeed::kBox : BspSeed::kDelaunay,
+                                              max_seed_conflicts);
   st.seed_tets = complex->stats().seed_tets;
   st.seed_conflicts = complex->stats().seed_conflicts;
-  if (options.seed == Seed::kAuto &&
-      static_cast<double>(st.seed_conflicts) >
-          MeshOptions::kSeedConflictsPerTriangle * static_cast<double>(surface.num_triangles())) {
+  if (complex->stats().seed_abandoned) {
     complex.reset();
     complex = std::make_unique<BspComplex>(geo, surface, tri_plane, BspSeed::kBox);
   }

@@ -95,6 +95,9 @@ struct BspStats {
   std::int64_t seed_tets = 0;       ///< cells the complex started from beside the box (BspSeed::kDelaunay)
   std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs after seeding
   std::int64_t seed_faces_relabelled = 0;  ///< seed faces found on an input plane only by the walk
+  /// The seed's conflict lists passed max_seed_conflicts and were abandoned: the complex is
+  /// unusable (the caller starts from the box instead).
+  bool seed_abandoned = false;
   std::int64_t splits = 0;          ///< internal BSP nodes
   std::int64_t leaves = 0;          ///< convex cells
   std::int64_t bsp_points = 0;      ///< vertices created by splits (TPI points)
@@ -110,8 +113,11 @@ class BspComplex {
   /// `geo` holds the input points as explicit points 0..#P-1 with vertices of the same ids, and
   /// the planes; `tri_plane[t]` is the plane of input triangle t.
   /// `seed`: see BspSeed (kDelaunay also needs the box corners as the last 8 explicit points).
+  /// `max_seed_conflicts` (kDelaunay; -1: no bound): when the (seed tet, crossing triangle) pairs
+  /// pass it, the walks stop and stats().seed_abandoned is set (long triangles across many seed
+  /// tets: the walks alone would cost more than the box's partition).
   BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::vector<Index> tri_plane,
-             BspSeed seed = BspSeed::kBox);
+             BspSeed seed = BspSeed::kBox, std::int64_t max_seed_conflicts = -1);
   /// Which sampled candidates choose_plane scores: the i-th is the conflict list's entry
   /// (i * n / ncand + candidate_shift) mod n. 0 (the default) is the paper's sampling; another
   /// value gives another, equally valid partition (the mesher's last retry).
@@ -168,7 +174,7 @@ class BspComplex {
   void make_box();
   /// bsp_seed.cpp: the cells are the Delaunay tets of the used input points and the box corners;
   /// conflict lists by a walk and a separating-axis test per input triangle.
-  void seed_delaunay();
+  void seed_delaunay(std::int64_t max_conflicts);
   Index new_face(BspFace f);
   void register_edges(Index f);
   void unregister_edges(Index f);
