@@ -179,6 +179,7 @@ def _mesh_on_cad(args, progress):
     unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
                                             ("--surface-points", args.surface_points),
                                             ("--steiner-effort", args.steiner_effort),
+                                            ("--bsp-seed", args.bsp_seed),
                                             ("--reorient", args.reorient or None),
                                             ("--write-intersections", args.write_intersections))
                    if value is not None]
@@ -230,6 +231,7 @@ def _cmd_mesh(args):
                      "order": args.order,
                      "allow_boundary_steiner": args.allow_boundary_steiner,
                      "steiner_effort": args.steiner_effort,
+                     "bsp_seed": args.bsp_seed,
                      "reorient": args.reorient,
                      "max_memory": args.max_memory_bytes},
             progress=progress)
@@ -439,6 +441,11 @@ def build_parser():
                    help="work (exact orientation tests, cavity growth) the core may spend removing "
                         "one interior Steiner point (default 1000000; 0: no bound, fewer Steiner "
                         "points, possibly much slower)")
+    m.add_argument("--bsp-seed", choices=("auto", "delaunay", "box"), default=None,
+                   help="where the core's BSP starts: the Delaunay tetrahedralization of the input "
+                        "points (only the cells an input triangle crosses are split) or one box "
+                        "(the paper's auto-partition); auto (default): the Delaunay seed unless "
+                        "the input triangles cross more than 4 of its tets each on average")
     m.add_argument("--on-cad", action="store_true",
                    help="CAD input: mesh as the FreeCAD mesher does (needs FreeCAD): boundary "
                         "points the refinement adds and tet10 mid-nodes go onto the CAD faces and "

@@ -257,6 +257,24 @@ def test_mesh_steiner_effort_bounds_the_interior_removal(cli, tmp_path):
     assert not (tmp_path / "x.vtu").exists()
 
 
+def test_mesh_bsp_seed_picks_where_the_bsp_starts(cli, tmp_path):
+    """``--bsp-seed delaunay|box``: the stats say which start made the mesh, both meshes pass the
+    checker with no Steiner point on the surface; an unknown value is refused (exit 2)."""
+    hinge = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "corpus", "hinge.off")
+    for seed in ("delaunay", "box"):
+        out = tmp_path / f"hinge_{seed}.vtu"
+        stats_file = tmp_path / f"hinge_{seed}.json"
+        r = run(cli, "mesh", hinge, "-o", out, "--stats-json", stats_file, "--quiet", "--bsp-seed", seed)
+        assert r.returncode == 0, r.stderr
+        assert json.loads(stats_file.read_text())["bsp_seed"] == seed
+        r = run(cli, "check", hinge, out, "--json")
+        assert r.returncode == 0, r.stdout
+        assert json.loads(r.stdout)["boundary_steiner_points"] == 0
+    r = run(cli, "mesh", hinge, "-o", tmp_path / "x.vtu", "--bsp-seed", "octree")
+    assert r.returncode == 2 and "bsp-seed" in r.stderr
+    assert not (tmp_path / "x.vtu").exists()
+
+
 def _boundary_nodes_off_cad(mesh, shape):
     """Largest distance from a boundary node (corners and tet10 mid-nodes of boundary faces) to
     the CAD shape's faces."""
