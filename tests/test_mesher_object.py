@@ -240,7 +240,7 @@ def test_property_names_reach_the_core_under_its_option_names():
                            projection=hook)
     assert opts == {"size": 5.0, "min_size": 1.0, "radius_edge": 1.5, "order": 2,
                     "allow_boundary_steiner": False, "projection": hook,
-                    "separate_face_tags": True}
+                    "separate_face_tags": True, "bsp_seed": "box"}
     assert "min_size" not in mp.core_options(mp.MeshParameters(max_size=5))
 
 

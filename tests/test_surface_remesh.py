@@ -333,13 +333,11 @@ def test_tet10_falls_back_to_a_finer_tessellation_and_says_so(fc, monkeypatch):
     """With the slides and the surface mends off, the filleted cylinder's first attempt stops on
     inverted elements; mesh_cad_shape then meshes it once more from a tessellation with half the
     AngularDeflection, returns that valid mesh (every boundary node on its CAD face) and says so
-    in a note and in the stats. (Radius 12: since the Delaunay-seeded core of session 13, the
-    radius-10 cylinder meshes at the first attempt even without the slides; 12 and 15 still
-    need the finer tessellation, 20 fails both.)"""
+    in a note and in the stats."""
     freecad, Part, _ = fc
     monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
     monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)
-    shape = filleted_cylinder(fc, radius=12.0)
+    shape = filleted_cylinder(fc)
     params = mesh_pipeline.MeshParameters(order=2)
     stages = []
     result = mesh_pipeline.mesh_cad_shape(shape, params,
