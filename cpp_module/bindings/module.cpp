@@ -183,6 +183,11 @@ PYBIND11_MODULE(_bsptet, m) {
         d["seed_conflicts"] = st.seed_conflicts;
         d["seed_fell_back"] = st.seed_fell_back;
         d["seed_faces_relabelled"] = st.seed_faces_relabelled;
+        d["seed_missing_edges"] = st.seed_missing_edges;
+        d["seed_recovered_edges"] = st.seed_recovered_edges;
+        d["seed_flips"] = st.seed_flips;
+        d["seed_missing_faces"] = st.seed_missing_faces;
+        d["seed_recovered_faces"] = st.seed_recovered_faces;
         d["bsp_seed"] = st.delaunay_seeded ? "delaunay" : "box";  // what the mesh came from
         d["steiner_points_before_removal"] = st.steiner_before_removal;
         d["surface_steiner_points_before_removal"] = st.boundary_steiner_before_removal;

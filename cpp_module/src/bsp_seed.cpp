@@ -23,6 +23,10 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <tuple>
+#include <unordered_set>
+#include <utility>
+#include <vector>
 
 #include "bsptet/bsp_complex.h"
 #include "bsptet/cell_delaunay.h"
@@ -37,6 +41,8 @@ namespace {
 // positive tet), as in cell_delaunay.cpp.
 constexpr int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
 constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+// Flips tried per missing input edge (SeedFlips::recover_edge), from each end.
+constexpr int kMaxFlipsPerEdge = 8;
 
 std::uint64_t spread3(std::uint64_t x) {  // 21 bits -> every third bit of 63
   x &= 0x1fffffULL;
@@ -137,6 +143,262 @@ int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 
   return weak ? 1 : 2;
 }
 
+// The seed need not be Delaunay: any tetrahedralization of the points gives convex cells. Input
+// edges missing from it (a nearly planar quad whose Delaunay diagonal is not the input's, the
+// common case on tessellated curved faces) make their triangles cross seed tets, and every
+// crossing costs BSP points and Steiner points later. So missing input edges are recovered by
+// flips where a few suffice, each decided exactly (every new tet strictly positive by orient3d
+// on the explicit doubles), never removing an input triangle or an input edge:
+//  * 2-3 flip of the face the segment ab leaves its first tet through (adds edge a-f, removes no
+//    edge), repeated towards b a bounded number of times;
+//  * 4-4 flip when ab passes exactly through the interior of an edge cd with four tets around
+//    it, a and b among them (a planar quad: edge cd replaced by ab).
+class SeedFlips {
+ public:
+  using Tet = std::array<Index, 4>;
+  template <class PointOf>
+  SeedFlips(std::vector<Tet>& tets, Index num_vertices, PointOf point_of) : tets_(tets), inc_(num_vertices) {
+    pts_.resize(static_cast<std::size_t>(num_vertices));
+    for (Index v = 0; v < num_vertices; ++v) pts_[v] = point_of(v);
+    alive_.assign(tets_.size(), 1);
+    for (Index t = 0; t < static_cast<Index>(tets_.size()); ++t)
+      for (Index v : tets_[t]) inc_[v].push_back(t);
+  }
+
+  void protect_triangle(Index a, Index b, Index c) {
+    std::array<Index, 3> k{{a, b, c}};
+    std::sort(k.begin(), k.end());
+    protected_faces_.insert(key3(k));
+    protected_edges_.insert(key2(a, b));
+    protected_edges_.insert(key2(b, c));
+    protected_edges_.insert(key2(a, c));
+  }
+
+  bool has_edge(Index a, Index b) const {
+    for (Index t : inc_[a])
+      if (alive_[t] && contains(tets_[t], b)) return true;
+    return false;
+  }
+
+  /// Tries to make (a, b) an edge with at most `max_flips` flips; true when it is one.
+  bool recover_edge(Index a, Index b, int max_flips) {
+    for (int it = 0; it <= max_flips; ++it) {
+      if (has_edge(a, b)) return true;
+      if (it == max_flips) return false;
+      bool flipped = false, degenerate = false;
+      for (std::size_t k = 0; k < inc_[a].size() && !flipped && !degenerate; ++k) {
+        const Index t = inc_[a][k];
+        if (!alive_[t]) continue;
+        const Tet& q = tets_[t];
+        const int ia = index_of(q, a);
+        // b against the three faces through a, each oriented with the tet on its positive side.
+        int zeros = 0, zero_face = -1;
+        bool inside = true;
+        for (int j = 0; j < 4 && inside; ++j) {
+          if (j == ia) continue;
+          const int s = to_int(orient3d(pts_[q[kFace[j][0]]], pts_[q[kFace[j][1]]], pts_[q[kFace[j][2]]], pts_[b]));
+          if (s < 0) inside = false;
+          if (s == 0) {
+            ++zeros;
+            zero_face = j;
+          }
+        }
+        if (!inside) continue;
+        if (zeros == 0) {
+          flipped = flip23(t, ia);
+          degenerate = !flipped;  // the segment leaves through that face: nothing else to try
+        } else if (zeros == 1) {
+          // Through the interior of the edge of the face opposite a that is not on face zero_face.
+          Index c = -1, d = -1;
+          for (int j = 0; j < 4; ++j)
+            if (j != ia && j != zero_face) (c < 0 ? c : d) = q[j];
+          flipped = flip44(a, b, c, d);
+          degenerate = !flipped;
+        }
+      }
+      if (!flipped) return false;
+    }
+    return false;
+  }
+
+  bool has_face(Index a, Index b, Index c) const { return tet_with(a, b, c, -1) >= 0; }
+
+  /// Input triangle (a, b, c) whose edges are seed edges but which is not a seed face: where one
+  /// seed edge (d, e) pierces it with exactly the three tets (d, e, a, b), (d, e, b, c),
+  /// (d, e, c, a) around it, a 3-2 flip makes it a face. True when it is one.
+  bool recover_face(Index a, Index b, Index c) {
+    if (has_face(a, b, c)) return true;
+    for (const auto& [u, w, o] : {std::tuple{a, b, c}, std::tuple{b, c, a}, std::tuple{c, a, b}})
+      for (Index t : inc_[u]) {
+        if (!alive_[t] || !contains(tets_[t], w)) continue;
+        Index d = -1, e = -1;
+        for (Index v : tets_[t])
+          if (v != u && v != w) (d < 0 ? d : e) = v;
+        if (d == o || e == o) continue;
+        if (flip32(d, e, a, b, c)) return has_face(a, b, c);
+      }
+    return false;
+  }
+
+  /// The alive tets, in order.
+  std::vector<Tet> result() const {
+    std::vector<Tet> out;
+    for (std::size_t t = 0; t < tets_.size(); ++t)
+      if (alive_[t]) out.push_back(tets_[t]);
+    return out;
+  }
+  std::int64_t flips() const { return flips_; }
+
+ private:
+  static bool contains(const Tet& q, Index v) { return q[0] == v || q[1] == v || q[2] == v || q[3] == v; }
+  static int index_of(const Tet& q, Index v) {
+    for (int i = 0; i < 4; ++i)
+      if (q[i] == v) return i;
+    return -1;
+  }
+  static std::uint64_t key2(Index a, Index b) {
+    if (a > b) std::swap(a, b);
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  }
+  static std::array<Index, 3> key3(std::array<Index, 3> k) {
+    std::sort(k.begin(), k.end());
+    return k;
+  }
+  struct Key3Hash {
+    std::size_t operator()(const std::array<Index, 3>& k) const {
+      return std::hash<std::uint64_t>()((static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[0])) << 42) ^
+                                        (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[1])) << 21) ^
+                                        static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[2])));
+    }
+  };
+  bool face_protected(Index x, Index y, Index z) const {
+    return protected_faces_.count(key3({x, y, z})) > 0;
+  }
+  /// The alive tet other than `not_t` with the three vertices, or -1.
+  Index tet_with(Index x, Index y, Index z, Index not_t) const {
+    for (Index t : inc_[x])
+      if (t != not_t && alive_[t] && contains(tets_[t], y) && contains(tets_[t], z)) return t;
+    return -1;
+  }
+  bool positive(const Tet& q) const { return orient3d(pts_[q[0]], pts_[q[1]], pts_[q[2]], pts_[q[3]]) == Sign::kPositive; }
+  /// Tet q with vertex `from` replaced by `to`: a tet of the flip's new set that keeps q's faces
+  /// through the other three vertices (so it must be positive in q's order, no reordering).
+  static Tet substituted(Tet q, Index from, Index to) {
+    for (Index& v : q)
+      if (v == from) v = to;
+    return q;
+  }
+  void replace(const std::vector<Index>& old_tets, const std::vector<Tet>& new_tets) {
+    for (Index t : old_tets) {
+      alive_[t] = 0;
+      for (Index v : tets_[t]) {
+        auto& l = inc_[v];
+        l.erase(std::find(l.begin(), l.end(), t));
+      }
+    }
+    for (const Tet& q : new_tets) {
+      const Index t = static_cast<Index>(tets_.size());
+      tets_.push_back(q);
+      alive_.push_back(1);
+      for (Index v : q) inc_[v].push_back(t);
+    }
+    ++flips_;
+  }
+  // Tet t and its neighbour across the face opposite vertex ia: three tets around the new edge.
+  bool flip23(Index t, int ia) {
+    const Tet q = tets_[t];
+    const Index c = q[kFace[ia][0]], d = q[kFace[ia][1]], e = q[kFace[ia][2]];
+    if (face_protected(c, d, e)) return false;
+    const Index t2 = tet_with(c, d, e, t);
+    if (t2 < 0) return false;
+    Index f = -1;
+    for (Index v : tets_[t2])
+      if (v != c && v != d && v != e) f = v;
+    // Each new tet keeps one face of t through a (its other vertex replaced by f).
+    std::vector<Tet> made;
+    for (Index x : {c, d, e}) {
+      const Tet n = substituted(q, x, f);
+      if (!positive(n)) return false;
+      made.push_back(n);
+    }
+    replace({t, t2}, made);
+    return true;
+  }
+  // Edge (d, e) with exactly three tets around it, whose other vertices are a, b, c: replaced by
+  // the two tets over face (a, b, c).
+  bool flip32(Index d, Index e, Index a, Index b, Index c) {
+    if (protected_edges_.count(key2(d, e))) return false;
+    std::vector<Index> ring;
+    for (Index t : inc_[d])
+      if (alive_[t] && contains(tets_[t], e)) ring.push_back(t);
+    if (ring.size() != 3) return false;
+    for (Index t : ring) {
+      Index u = -1, w = -1;
+      for (Index v : tets_[t])
+        if (v != d && v != e) (u < 0 ? u : w) = v;
+      const bool in_abc = (u == a || u == b || u == c) && (w == a || w == b || w == c);
+      if (!in_abc || face_protected(d, e, u) || face_protected(d, e, w)) return false;
+    }
+    // The tet of the ring through a and b keeps its faces (a, b, d) and (a, b, e): its vertex e
+    // (resp. d) replaced by c.
+    Index tab = -1;
+    for (Index t : ring)
+      if (contains(tets_[t], a) && contains(tets_[t], b)) tab = t;
+    if (tab < 0) return false;
+    const Tet n1 = substituted(tets_[tab], e, c), n2 = substituted(tets_[tab], d, c);
+    if (!positive(n1) || !positive(n2)) return false;
+    replace(ring, {n1, n2});
+    return true;
+  }
+  // Edge (c, d) with four tets around it whose other vertices are a, x, b, y in ring order:
+  // replaced by edge (a, b).
+  bool flip44(Index a, Index b, Index c, Index d) {
+    if (protected_edges_.count(key2(c, d))) return false;
+    std::vector<Index> ring;
+    for (Index t : inc_[c])
+      if (alive_[t] && contains(tets_[t], d)) ring.push_back(t);
+    if (ring.size() != 4) return false;
+    std::vector<Index> others;  // the ring's vertices besides a and b
+    bool has_a = false, has_b = false;
+    for (Index t : ring)
+      for (Index v : tets_[t]) {
+        if (v == c || v == d) continue;
+        if (v == a) has_a = true;
+        else if (v == b) has_b = true;
+        else if (std::find(others.begin(), others.end(), v) == others.end()) others.push_back(v);
+      }
+    if (!has_a || !has_b || others.size() != 2) return false;
+    for (Index t : ring) {
+      Index u = -1, w = -1;
+      for (Index v : tets_[t])
+        if (v != c && v != d) (u < 0 ? u : w) = v;
+      if (face_protected(c, d, u) || face_protected(c, d, w)) return false;
+    }
+    // Each new tet keeps a face (a, x, c) or (a, x, d) of a ring tet through a, its other ring
+    // vertex replaced by b.
+    std::vector<Tet> made;
+    for (Index t : ring) {
+      if (!contains(tets_[t], a)) continue;
+      for (Index drop : {c, d}) {
+        const Tet n = substituted(tets_[t], drop, b);
+        if (!positive(n)) return false;
+        made.push_back(n);
+      }
+    }
+    if (made.size() != 4) return false;
+    replace(ring, made);
+    return true;
+  }
+
+  std::vector<Tet>& tets_;
+  std::vector<std::vector<Index>> inc_;
+  std::vector<Vec3> pts_;
+  std::vector<char> alive_;
+  std::unordered_set<std::array<Index, 3>, Key3Hash> protected_faces_;
+  std::unordered_set<std::uint64_t> protected_edges_;
+  std::int64_t flips_ = 0;
+};
+
 }  // namespace
 
 void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
@@ -178,7 +440,28 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   CellDelaunay dt;
   if (!delaunay_points(geo_, std::move(order), dt))
     throw MeshingError(ErrorCode::kInternal, "bsp", -1, "the Delaunay seed of the input points failed");
-  const std::vector<std::array<Index, 4>>& tets = dt.tets;
+  std::vector<std::array<Index, 4>> tets = std::move(dt.tets);
+  {
+    SeedFlips flips(tets, corner0_ + 8, point_of);
+    for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
+      flips.protect_triangle(triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2));
+    for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
+      for (int k = 0; k < 3; ++k) {
+        const Index a = triangle_vertex(tr, k), b = triangle_vertex(tr, (k + 1) % 3);
+        if (a > b || flips.has_edge(a, b)) continue;  // each edge once (its other triangle has it reversed)
+        ++stats_.seed_missing_edges;
+        if (flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge))
+          ++stats_.seed_recovered_edges;
+      }
+    for (Index tr = 0; tr < surface_.num_triangles(); ++tr) {
+      const Index a = triangle_vertex(tr, 0), b = triangle_vertex(tr, 1), c = triangle_vertex(tr, 2);
+      if (flips.has_face(a, b, c) || !flips.has_edge(a, b) || !flips.has_edge(b, c) || !flips.has_edge(c, a)) continue;
+      ++stats_.seed_missing_faces;
+      if (flips.recover_face(a, b, c)) ++stats_.seed_recovered_faces;
+    }
+    stats_.seed_flips = flips.flips();
+    if (flips.flips() > 0) tets = flips.result();
+  }
   const Index nt = static_cast<Index>(tets.size());
   stats_.seed_tets = nt;
 
@@ -215,6 +498,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
     return -1;
   };
+  std::vector<std::pair<std::array<Index, 3>, Index>> face_of_corners;  // sorted corners -> face, sorted
+  face_of_corners.reserve(slots.size() / 2 + 1);
   for (std::size_t s = 0; s < slots.size();) {
     std::size_t e = s + 1;
     while (e < slots.size() && slots[e].key == slots[s].key) ++e;
@@ -245,6 +530,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       f.cell[1] = t1;
     }
     const Index id = new_face(std::move(f));
+    face_of_corners.push_back({slots[s].key, id});
     tet_face[t0][i0] = id;
     if (t1 >= 0) {
       tet_face[t1][slots[s + 1].i] = id;
@@ -262,7 +548,11 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
   }
 
-  // 3. Conflict lists and coplanar lists, by a walk over the tets each triangle meets.
+  // 3. Conflict lists and coplanar lists. An input triangle that is a face of the seed crosses
+  // no tet (faces of a tetrahedralization never meet a tet's interior) and overlaps no other
+  // face: it goes on that face's coplanar list, nothing more. Any other triangle walks over the
+  // tets it meets (the separating-axis test cannot always tell a tet that only shares a corner
+  // with the triangle from one it crosses, and counts it as crossed: a conservative superset).
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<Index> queue;
@@ -271,6 +561,17 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
                                  surface_.point(triangle_vertex(tr, 2))}};
     const std::array<Index, 3> qid{{triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2)}};
     const Index plane = tri_plane_[tr];
+    {
+      std::array<Index, 3> key = qid;
+      std::sort(key.begin(), key.end());
+      const auto it = std::lower_bound(face_of_corners.begin(), face_of_corners.end(),
+                                       std::pair<std::array<Index, 3>, Index>{key, -1});
+      if (it != face_of_corners.end() && it->first == key && faces_[it->second].plane == plane) {
+        faces_[it->second].coplanar.push_back(tr);
+        ++stats_.seed_face_triangles;
+        continue;
+      }
+    }
     ++stamp;
     queue.clear();
     const Index start = vertex_tet[triangle_vertex(tr, 0)];

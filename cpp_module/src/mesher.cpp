@@ -206,6 +206,11 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
                                               max_seed_conflicts);
   st.seed_tets = complex->stats().seed_tets;
   st.seed_conflicts = complex->stats().seed_conflicts;
+  st.seed_missing_edges = complex->stats().seed_missing_edges;
+  st.seed_recovered_edges = complex->stats().seed_recovered_edges;
+  st.seed_flips = complex->stats().seed_flips;
+  st.seed_missing_faces = complex->stats().seed_missing_faces;
+  st.seed_recovered_faces = complex->stats().seed_recovered_faces;
   if (complex->stats().seed_abandoned) {
     complex.reset();
     complex = std::make_unique<BspComplex>(geo, surface, tri_plane, BspSeed::kBox);

@@ -95,6 +95,12 @@ struct BspStats {
   std::int64_t seed_tets = 0;       ///< cells the complex started from beside the box (BspSeed::kDelaunay)
   std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs after seeding
   std::int64_t seed_faces_relabelled = 0;  ///< seed faces found on an input plane only by the walk
+  std::int64_t seed_missing_edges = 0;    ///< input edges not in the Delaunay seed
+  std::int64_t seed_recovered_edges = 0;  ///< of those, made seed edges by flips
+  std::int64_t seed_missing_faces = 0;    ///< input triangles with their edges but not a face of the seed
+  std::int64_t seed_recovered_faces = 0;  ///< of those, made seed faces by 3-2 flips
+  std::int64_t seed_flips = 0;            ///< 2-3, 3-2 and 4-4 flips made for them
+  std::int64_t seed_face_triangles = 0;   ///< input triangles that are faces of the seed (no walk)
   /// The seed's conflict lists passed max_seed_conflicts and were abandoned: the complex is
   /// unusable (the caller starts from the box instead).
   bool seed_abandoned = false;

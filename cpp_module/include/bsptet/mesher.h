@@ -65,6 +65,8 @@ struct MeshStats {
   std::int64_t seed_tets = 0;  ///< cells of the Delaunay seed (also when kAuto then took the box)
   std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs (BspStats; kAuto stops counting past its bound)
   std::int64_t seed_faces_relabelled = 0;  ///< seed faces given their input plane by the walk (BspStats)
+  std::int64_t seed_missing_edges = 0, seed_recovered_edges = 0, seed_flips = 0;  ///< BspStats
+  std::int64_t seed_missing_faces = 0, seed_recovered_faces = 0;                ///< BspStats
   std::int64_t seed_fell_back = 0;  ///< the seeded attempt failed and the box meshed (tetrahedralize's retries)
   std::int64_t steiner_before_removal = 0, boundary_steiner_before_removal = 0, collapsed = 0, relocated = 0, pushed = 0;
   std::int64_t apex_cells = 0, pulled_cells = 0;
