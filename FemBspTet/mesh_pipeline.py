@@ -252,17 +252,16 @@ def _json_default(value):
 # options for the core
 # ------------------------------------------------------------------------------------------
 
-#: Where the core's BSP starts in this pipeline (``core.tetrahedralize``'s ``bsp_seed``). The
-#: paper's box, not the Delaunay seed that is the core's default since session 13: on CAD
-#: tessellations the seed's near-Delaunay mesh puts flat tets across nearly flat folds of the
-#: surface (two boundary faces each) that the quality stage cannot remove without moving the
-#: surface. Measured at tet10, default parameters (bench/freecad_cad_corpus.py, the 8 public CAD
-#: parts that mesh): the worst dihedral angle is higher from the box on 7 of 8 (part.step 1.87
-#: against 0.01 deg, Kurbelwelle 2.36 against 0.78, wrenchnut 1.21 against 0.36), the same parts
-#: mesh either way, and the core is a small share of the pipeline's time here. (Measured with the
-#: plain Delaunay seed; with its input edges and faces recovered by flips, checked at order 1 on
-#: two parts only: part.step 1.87 from the box against 2.02, Kurbelwelle 2.36 against 0.84.)
-PIPELINE_BSP_SEED = "box"
+#: Where the core's BSP starts in this pipeline (``core.tetrahedralize``'s ``bsp_seed``), by
+#: ElementOrder. Measured on the 13 public CAD parts (bench/freecad_cad_corpus.py
+#: /work/shared/data/corpus/cad --order 2, session 13):
+#:  * tet10: from the Delaunay seed (with its flips) 10 parts mesh, from the paper's box 8
+#:    (bottle and featuretype mesh only from the seed; SampleCrankshaft4A and U_Joint_2 from
+#:    neither): the seed;
+#:  * the worst dihedral angle of the 8 parts that mesh both ways is higher from the box on 6
+#:    (Kurbelwelle 2.36 against 0.84 deg, t20_data 4.83 against 2.59; part.step 1.87 against
+#:    2.02), and at order 1 every part but the open shell meshes from the box: the box there.
+PIPELINE_BSP_SEED = {1: "box", 2: "auto"}
 
 
 def core_options(params, projection=None):
@@ -273,7 +272,7 @@ def core_options(params, projection=None):
     opts = {CORE_OPTION_OF["order"]: int(params.order),
             CORE_OPTION_OF["allow_boundary_steiner"]: bool(params.allow_boundary_steiner),
             "separate_face_tags": True,
-            "bsp_seed": PIPELINE_BSP_SEED}
+            "bsp_seed": PIPELINE_BSP_SEED[int(params.order)]}
     for field in ("max_size", "min_size", "quality_bound"):
         value = getattr(params, field)
         if value > 0:

@@ -240,7 +240,7 @@ def test_property_names_reach_the_core_under_its_option_names():
                            projection=hook)
     assert opts == {"size": 5.0, "min_size": 1.0, "radius_edge": 1.5, "order": 2,
                     "allow_boundary_steiner": False, "projection": hook,
-                    "separate_face_tags": True, "bsp_seed": "box"}
+                    "separate_face_tags": True, "bsp_seed": "auto"}
     assert "min_size" not in mp.core_options(mp.MeshParameters(max_size=5))
 
 
@@ -281,6 +281,7 @@ def test_parameters_are_validated_with_property_names():
     assert mp.MeshParameters.from_dict(p.to_dict()) == p
     opts = mp.core_options(p)
     assert opts["size"] == 5 and opts["order"] == 1 and "projection" not in opts
+    assert opts["bsp_seed"] == "box"  # order 1: the start with the better worst angles
 
 
 def test_mesh_shape_returns_a_femmesh(fc):
