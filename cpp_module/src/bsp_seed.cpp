@@ -37,9 +37,7 @@ namespace bsptet {
 
 namespace {
 
-// Face opposite vertex i, ordered so that vertex i lies on its positive side (orient3d > 0 for a
-// positive tet), as in cell_delaunay.cpp.
-constexpr int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+constexpr auto& kFace = kTetOppositeFace;  // types.h
 constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 // Flips tried per missing input edge (SeedFlips::recover_edge), from each end.
 constexpr int kMaxFlipsPerEdge = 8;
@@ -229,11 +227,8 @@ class SeedFlips {
   bool recover_face(Index a, Index b, Index c) {
     if (has_face(a, b, c)) return true;
     for (const auto& [u, w, o] : {std::tuple{a, b, c}, std::tuple{b, c, a}, std::tuple{c, a, b}})
-      for (Index t : inc_[u]) {
-        if (!alive_[t] || !contains(tets_[t], w)) continue;
-        Index d = -1, e = -1;
-        for (Index v : tets_[t])
-          if (v != u && v != w) (d < 0 ? d : e) = v;
+      for (Index t : ring_around(u, w)) {
+        const auto [d, e] = other_two(t, u, w);
         if (d == o || e == o) continue;
         if (flip32(d, e, a, b, c)) return has_face(a, b, c);
       }
@@ -279,6 +274,20 @@ class SeedFlips {
     for (Index t : inc_[x])
       if (t != not_t && alive_[t] && contains(tets_[t], y) && contains(tets_[t], z)) return t;
     return -1;
+  }
+  /// The alive tets around edge (c, d).
+  std::vector<Index> ring_around(Index c, Index d) const {
+    std::vector<Index> ring;
+    for (Index t : inc_[c])
+      if (alive_[t] && contains(tets_[t], d)) ring.push_back(t);
+    return ring;
+  }
+  /// The two vertices of tet t besides c and d.
+  std::array<Index, 2> other_two(Index t, Index c, Index d) const {
+    std::array<Index, 2> o{{-1, -1}};
+    for (Index v : tets_[t])
+      if (v != c && v != d) (o[0] < 0 ? o[0] : o[1]) = v;
+    return o;
   }
   bool positive(const Tet& q) const { return orient3d(pts_[q[0]], pts_[q[1]], pts_[q[2]], pts_[q[3]]) == Sign::kPositive; }
   /// Tet q with vertex `from` replaced by `to`: a tet of the flip's new set that keeps q's faces
@@ -328,14 +337,10 @@ class SeedFlips {
   // the two tets over face (a, b, c).
   bool flip32(Index d, Index e, Index a, Index b, Index c) {
     if (protected_edges_.count(key2(d, e))) return false;
-    std::vector<Index> ring;
-    for (Index t : inc_[d])
-      if (alive_[t] && contains(tets_[t], e)) ring.push_back(t);
+    const std::vector<Index> ring = ring_around(d, e);
     if (ring.size() != 3) return false;
     for (Index t : ring) {
-      Index u = -1, w = -1;
-      for (Index v : tets_[t])
-        if (v != d && v != e) (u < 0 ? u : w) = v;
+      const auto [u, w] = other_two(t, d, e);
       const bool in_abc = (u == a || u == b || u == c) && (w == a || w == b || w == c);
       if (!in_abc || face_protected(d, e, u) || face_protected(d, e, w)) return false;
     }
@@ -354,9 +359,7 @@ class SeedFlips {
   // replaced by edge (a, b).
   bool flip44(Index a, Index b, Index c, Index d) {
     if (protected_edges_.count(key2(c, d))) return false;
-    std::vector<Index> ring;
-    for (Index t : inc_[c])
-      if (alive_[t] && contains(tets_[t], d)) ring.push_back(t);
+    const std::vector<Index> ring = ring_around(c, d);
     if (ring.size() != 4) return false;
     std::vector<Index> others;  // the ring's vertices besides a and b
     bool has_a = false, has_b = false;
@@ -369,9 +372,7 @@ class SeedFlips {
       }
     if (!has_a || !has_b || others.size() != 2) return false;
     for (Index t : ring) {
-      Index u = -1, w = -1;
-      for (Index v : tets_[t])
-        if (v != c && v != d) (u < 0 ? u : w) = v;
+      const auto [u, w] = other_two(t, c, d);
       if (face_protected(c, d, u) || face_protected(c, d, w)) return false;
     }
     // Each new tet keeps a face (a, x, c) or (a, x, d) of a ring tet through a, its other ring

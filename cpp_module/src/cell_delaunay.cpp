@@ -98,9 +98,7 @@ std::vector<std::array<Index, 3>> delaunay_face(ImplicitGeometry& geo, const Bsp
 namespace {
 
 constexpr int kInf = -1;
-// Face opposite vertex i, ordered so that vertex i lies on its positive side (orient3d > 0 for a
-// positive tet).
-constexpr int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+constexpr auto& kFace = kTetOppositeFace;  // types.h
 
 struct Tet {
   std::array<int, 4> v;   ///< local point ids; a ghost has kInf at position 3 (and only there)

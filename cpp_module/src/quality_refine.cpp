@@ -409,7 +409,7 @@ class Refiner {
   void lift_for_curved_elements() {
     if (!o_.projection || o_.order != 2) return;
     static const int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
-    static const int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+    constexpr auto& kFace = kTetOppositeFace;  // types.h
     std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> tags;
     for (const auto& [face, parent] : m_.boundary_faces())
       for (int k = 0; k < 3; ++k) {
@@ -823,7 +823,7 @@ class Refiner {
 
   // One interior point that improves tet t (see insert_pass); false when no candidate does.
   bool insert_for(Index t) {
-    static const int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+    constexpr auto& kFace = kTetOppositeFace;  // types.h
     {
       const auto q = m_.tet(t);
       Vec3 P[4];

@@ -16,9 +16,7 @@ namespace bsptet {
 
 namespace {
 
-// The face of a tet opposite its vertex k, ordered so that vertex k is on its positive side
-// (types.h: the outward faces reversed).
-constexpr int kOppositeFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+constexpr auto& kOppositeFace = kTetOppositeFace;  // types.h
 
 constexpr double kImprovement = 1e-9;  // degrees: a flip or move must raise the worst angle by more
 

@@ -17,6 +17,10 @@ namespace bsptet {
 
 using Index = std::int32_t;
 
+/// The face of a tet opposite its vertex k, ordered so that vertex k lies on its positive side
+/// (orient3d > 0 for a positive tet; the outward faces above, reversed).
+inline constexpr int kTetOppositeFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+
 struct Vec3 {
   double x = 0, y = 0, z = 0;
   double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
