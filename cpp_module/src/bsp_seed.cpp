@@ -20,6 +20,7 @@
 // may lie on an input plane without being corners of that plane's triangles).
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -405,6 +406,12 @@ class SeedFlips {
 void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   corner0_ = geo_.num_explicit() - 8;
   const Index input_planes = geo_.num_planes();
+  auto t0 = std::chrono::steady_clock::now();
+  auto lap = [&](const char* step) {
+    const auto t1 = std::chrono::steady_clock::now();
+    stats_.seed_seconds[step] += std::chrono::duration<double>(t1 - t0).count();
+    t0 = t1;
+  };
   // Vertex ids of explicit points are their point ids here (mesher.cpp adds them in order).
   auto point_of = [&](Index v) -> const Vec3& { return geo_.explicit_point(geo_.explicit_id(v)); };
   // 1. The points: the box corners first (their hull is the box, so every walk stays inside),
@@ -442,6 +449,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   if (!delaunay_points(geo_, std::move(order), dt))
     throw MeshingError(ErrorCode::kInternal, "bsp", -1, "the Delaunay seed of the input points failed");
   std::vector<std::array<Index, 4>> tets = std::move(dt.tets);
+  lap("seed_delaunay");
   {
     SeedFlips flips(tets, corner0_ + 8, point_of);
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
@@ -465,6 +473,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   }
   const Index nt = static_cast<Index>(tets.size());
   stats_.seed_tets = nt;
+  lap("seed_flips");
 
   // 2. Faces: one per distinct triangle of the tets, shared by its (one or two) tets.
   struct Slot {
@@ -549,6 +558,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
   }
 
+  lap("seed_faces");
   // 3. Conflict lists and coplanar lists. An input triangle that is a face of the seed crosses
   // no tet (faces of a tetrahedralization never meet a tet's interior) and overlaps no other
   // face: it goes on that face's coplanar list, nothing more. Any other triangle walks over the
@@ -589,6 +599,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
         cells_[t].conflict.push_back(tr);
         if (++stats_.seed_conflicts > max_conflicts && max_conflicts >= 0) {
           stats_.seed_abandoned = true;
+          lap("seed_walk");
           return;
         }
       }
@@ -617,6 +628,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       }
     }
   }
+  lap("seed_walk");
   // 4. Edge lines: the planes of the two faces of a tet through the edge (never the same
   // geometric plane), taken after the walk, which may have given faces their input plane.
   for (Index t = 0; t < nt; ++t) {
@@ -629,6 +641,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       edge_line_[key] = {faces_[tet_face[t][other[0]]].plane, faces_[tet_face[t][other[1]]].plane};
     }
   }
+  lap("seed_lines");
 }
 
 }  // namespace bsptet

@@ -421,6 +421,16 @@ std::array<T, 3> lifted_row2(const std::array<T, 4>& p, const std::array<T, 4>& 
 // vertex id.
 Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) {
   const std::array<Index, 5> ids{{a, b, c, d, e}};
+  {
+    const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d], &ve = verts_[e];
+    Sign s;
+    if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0 &&
+        ve.explicit_id >= 0 &&
+        lifted_det3_filter(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
+                           points_[vd.explicit_id], points_[ve.explicit_id], s) &&
+        s != Sign::kZero)
+      return s;
+  }
   int s0 = 0;
   const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d), *b4 = box(e);
   if (b0 && b1 && b2 && b3 && b4) {
@@ -479,6 +489,15 @@ Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) 
 Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis) {
   const std::array<Index, 4> ids{{a, b, c, d}};
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  {
+    const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
+    Sign s;
+    if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0 &&
+        lifted_det2_filter(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
+                           points_[vd.explicit_id], axis, s) &&
+        s != Sign::kZero)
+      return s;
+  }
   int s0 = 0;
   const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d);
   if (b0 && b1 && b2 && b3) {

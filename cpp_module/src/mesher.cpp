@@ -211,6 +211,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   st.seed_flips = complex->stats().seed_flips;
   st.seed_missing_faces = complex->stats().seed_missing_faces;
   st.seed_recovered_faces = complex->stats().seed_recovered_faces;
+  for (const auto& [step, sec] : complex->stats().seed_seconds) st.seconds_by_stage[step] += sec;
   if (complex->stats().seed_abandoned) {
     complex.reset();
     complex = std::make_unique<BspComplex>(geo, surface, tri_plane, BspSeed::kBox);

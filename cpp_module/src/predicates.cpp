@@ -14,6 +14,10 @@ constexpr double kUnitRoundoff = 1.1102230246251565e-16;  // 2^-53
 // orient3d and (3 + 16u)u for orient2d; we use slightly larger round constants.
 constexpr double kOrient3dBound = 8.0 * kUnitRoundoff;
 constexpr double kOrient2dBound = 4.0 * kUnitRoundoff;
+// The lifted determinants below have depth 10 (det4) and 9 (det3) in rounded operations (the
+// coordinate differences included); the standard bound gamma_n * permanent, with the permanent
+// itself rounded over at most 10 operations, stays under 11u; 16u leaves room.
+constexpr double kLiftedBound = 16.0 * kUnitRoundoff;
 // Below this magnitude products may have underflowed and the relative bound no longer holds.
 constexpr double kUnderflowGuard = 1e-280;
 
@@ -212,6 +216,53 @@ Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   if (orient3d_exact_in_doubles(a, b, c, d, certified)) return certified;
   if (orient3d_expansion(a, b, c, d, certified)) return certified;
   return orient3d_exact(a, b, c, d);
+}
+
+bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out) {
+  const Vec3* rows[4] = {&a, &b, &c, &d};
+  double x[4], y[4], z[4], l[4], la[4];
+  for (int i = 0; i < 4; ++i) {
+    x[i] = rows[i]->x - e.x, y[i] = rows[i]->y - e.y, z[i] = rows[i]->z - e.z;
+    l[i] = x[i] * x[i] + y[i] * y[i] + z[i] * z[i];
+    la[i] = l[i];  // already a sum of non-negative terms
+  }
+  // 2x2 minors of the (x, y) columns and their permanents.
+  auto m = [&](int i, int j) { return x[i] * y[j] - x[j] * y[i]; };
+  auto pm = [&](int i, int j) { return std::fabs(x[i] * y[j]) + std::fabs(x[j] * y[i]); };
+  const double m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3), m23 = m(2, 3);
+  const double p01 = pm(0, 1), p02 = pm(0, 2), p03 = pm(0, 3), p12 = pm(1, 2), p13 = pm(1, 3), p23 = pm(2, 3);
+  // det3 of rows (i, j, k) over (x, y, z) = z_i m_jk - z_j m_ik + z_k m_ij.
+  const double d123 = (z[1] * m23 - z[2] * m13) + z[3] * m12, d023 = (z[0] * m23 - z[2] * m03) + z[3] * m02,
+               d013 = (z[0] * m13 - z[1] * m03) + z[3] * m01, d012 = (z[0] * m12 - z[1] * m02) + z[2] * m01;
+  const double q123 = (std::fabs(z[1]) * p23 + std::fabs(z[2]) * p13) + std::fabs(z[3]) * p12,
+               q023 = (std::fabs(z[0]) * p23 + std::fabs(z[2]) * p03) + std::fabs(z[3]) * p02,
+               q013 = (std::fabs(z[0]) * p13 + std::fabs(z[1]) * p03) + std::fabs(z[3]) * p01,
+               q012 = (std::fabs(z[0]) * p12 + std::fabs(z[1]) * p02) + std::fabs(z[2]) * p01;
+  // Laplace expansion on the lift column (index 3): cofactor signs -, +, -, + for rows 0..3.
+  const double det = ((l[1] * d023 - l[0] * d123) + l[3] * d012) - l[2] * d013;
+  const double perm = ((la[1] * q023 + la[0] * q123) + la[3] * q012) + la[2] * q013;
+  if (!(std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > kLiftedBound * perm)) return false;
+  out = sign_of(det);
+  return true;
+}
+
+bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const Vec3* rows[3] = {&a, &b, &c};
+  double r[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const double dx = rows[i]->x - d.x, dy = rows[i]->y - d.y, dz = rows[i]->z - d.z;
+    const double dd[3] = {dx, dy, dz};
+    r[i][0] = dd[u], r[i][1] = dd[v], r[i][2] = dx * dx + dy * dy + dz * dz;
+  }
+  auto m = [&](int i, int j, int p, int q) { return r[i][p] * r[j][q] - r[i][q] * r[j][p]; };
+  auto pm = [&](int i, int j, int p, int q) { return std::fabs(r[i][p] * r[j][q]) + std::fabs(r[i][q] * r[j][p]); };
+  const double det = (r[0][0] * m(1, 2, 1, 2) - r[0][1] * m(1, 2, 0, 2)) + r[0][2] * m(1, 2, 0, 1);
+  const double perm = (std::fabs(r[0][0]) * pm(1, 2, 1, 2) + std::fabs(r[0][1]) * pm(1, 2, 0, 2)) +
+                      std::fabs(r[0][2]) * pm(1, 2, 0, 1);
+  if (!(std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > kLiftedBound * perm)) return false;
+  out = sign_of(det);
+  return true;
 }
 
 Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int axis) {

@@ -158,3 +158,73 @@ TEST(Orient2dProjected, FilterAgreesWithExact) {
           << "iteration " << it;
   }
 }
+
+// The lifted (in-sphere / in-circle) filters against ExactFloat: random points, points on a
+// common sphere (integer Pythagorean-like coordinates, exactly cospherical) moved by one ulp or
+// 2^-45, and scales from 2^-300 to 2^300. A certified sign must be the exact one; a zero
+// determinant must never be certified as non-zero.
+TEST(LiftedFilters, AgreeWithExact) {
+  const unsigned seed = 20261203u;
+  std::printf("seed %u\n", seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::uniform_int_distribution<int> scale_exp(-300, 300), pick(0, 3);
+  auto exact3 = [](const Vec3* p, const Vec3& e) {
+    ExactFloat r[4][4];
+    for (int i = 0; i < 4; ++i) {
+      const ExactFloat dx = ExactFloat(p[i].x) - ExactFloat(e.x), dy = ExactFloat(p[i].y) - ExactFloat(e.y),
+                       dz = ExactFloat(p[i].z) - ExactFloat(e.z);
+      r[i][0] = dx, r[i][1] = dy, r[i][2] = dz, r[i][3] = dx * dx + dy * dy + dz * dz;
+    }
+    auto m = [&](int i, int j, int a, int b) { return r[i][a] * r[j][b] - r[i][b] * r[j][a]; };
+    const ExactFloat det = m(0, 1, 0, 1) * m(2, 3, 2, 3) - m(0, 1, 0, 2) * m(2, 3, 1, 3) +
+                           m(0, 1, 0, 3) * m(2, 3, 1, 2) + m(0, 1, 1, 2) * m(2, 3, 0, 3) -
+                           m(0, 1, 1, 3) * m(2, 3, 0, 2) + m(0, 1, 2, 3) * m(2, 3, 0, 1);
+    return det.sign();
+  };
+  auto exact2 = [](const Vec3* p, const Vec3& d, int axis) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    ExactFloat r[3][3];
+    for (int i = 0; i < 3; ++i) {
+      const ExactFloat dd[3] = {ExactFloat(p[i].x) - ExactFloat(d.x), ExactFloat(p[i].y) - ExactFloat(d.y),
+                                ExactFloat(p[i].z) - ExactFloat(d.z)};
+      r[i][0] = dd[u], r[i][1] = dd[v], r[i][2] = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+    }
+    const ExactFloat det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
+                           r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    return det.sign();
+  };
+  // Exactly cospherical points: (±3, ±4, 0), (0, ±3, ±4), (±4, 0, ±3) on the sphere of radius 5.
+  const Vec3 sphere[] = {{3, 4, 0}, {-3, 4, 0}, {0, 3, 4}, {0, -3, 4}, {4, 0, 3}, {4, 0, -3}, {-4, 0, 3}, {0, 5, 0}};
+  int certified = 0, zeros = 0, trials = 0;
+  for (int it = 0; it < 40000; ++it) {
+    Vec3 p[5];
+    const int kind = it % 4;
+    const double s = std::ldexp(1.0, kind == 3 ? scale_exp(rng) : 0);
+    for (int i = 0; i < 5; ++i) {
+      if (kind == 0) {
+        p[i] = {U(rng), U(rng), U(rng)};
+      } else {
+        p[i] = sphere[(it * 7 + i * 3) % 8];
+        if (i == 4 && kind == 2) p[i].x = std::nextafter(p[i].x, pick(rng) < 2 ? 10.0 : -10.0);
+        if (i == 4 && kind == 1 && pick(rng) == 0) p[i].y += std::ldexp(1.0, -45);
+      }
+      p[i] = {p[i].x * s, p[i].y * s, p[i].z * s};
+    }
+    Sign f;
+    ++trials;
+    const int ex3 = exact3(p, p[4]);
+    zeros += ex3 == 0;
+    if (lifted_det3_filter(p[0], p[1], p[2], p[3], p[4], f)) {
+      ++certified;
+      ASSERT_EQ(static_cast<int>(f), ex3) << "it " << it;
+    }
+    const int axis = it % 3;
+    const int ex2 = exact2(p, p[3], axis);
+    if (lifted_det2_filter(p[0], p[1], p[2], p[3], axis, f)) ASSERT_EQ(static_cast<int>(f), ex2) << "it " << it;
+  }
+  std::printf("lifted_det3: %d of %d certified, %d exact zeros\n", certified, trials, zeros);
+  EXPECT_GT(zeros, 1000);           // the degenerate cases were really made
+  EXPECT_GT(certified, trials / 5);  // and the filter decides the random quarter (the rest is built degenerate)
+}

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -104,6 +105,10 @@ struct BspStats {
   /// The seed's conflict lists passed max_seed_conflicts and were abandoned: the complex is
   /// unusable (the caller starts from the box instead).
   bool seed_abandoned = false;
+  /// Seconds of the seed's steps: "seed_delaunay" (the points' Delaunay), "seed_flips" (edge and
+  /// face recovery), "seed_faces" (the complex's faces and planes), "seed_walk" (conflict lists),
+  /// "seed_lines" (edge lines). Measurement only: nothing depends on them.
+  std::map<std::string, double> seed_seconds;
   std::int64_t splits = 0;          ///< internal BSP nodes
   std::int64_t leaves = 0;          ///< convex cells
   std::int64_t bsp_points = 0;      ///< vertices created by splits (TPI points)

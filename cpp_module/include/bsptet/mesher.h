@@ -79,6 +79,9 @@ struct MeshStats {
   /// How many attempts failed before the mesh was made (tetrahedralize's retries: 0, along lines,
   /// then candidate shifts 1 and 2), and the BSP candidate shift of the attempt that made it.
   std::int64_t retries = 0, bsp_candidate_shift = 0;
+  /// Seconds per stage: input_check, planes, bsp (the seed included), classify, cell_tets,
+  /// steiner_removal, snap_round; and, inside bsp, the Delaunay seed's steps (seed_delaunay,
+  /// seed_flips, seed_faces, seed_walk, seed_lines: BspStats::seed_seconds).
   std::map<std::string, double> seconds_by_stage;
   /// The Steiner removal's phases (SteinerRemovalStats::seconds_by_phase, removed_by_phase).
   std::map<std::string, double> steiner_seconds_by_phase;

@@ -34,4 +34,12 @@ Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int a
 /// [2^-200, 2^200] (orient3d then uses orient3d_exact).
 bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
 
+/// Floating-point filters of the lifted determinants of ImplicitGeometry::lifted_det3 / lifted_det2
+/// (unperturbed), for double points: lifted_det3 is sign det4 over the rows a..d of
+/// (p - e, |p - e|^2); lifted_det2 is sign det3 over the rows a..c of ((p - d) projected by
+/// `axis` as orient2d_projected, |p - d|^2). True, and `out` set, when the double evaluation's
+/// proven error bound certifies the sign; false (out unset) when the caller must decide exactly.
+bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out);
+bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out);
+
 }  // namespace bsptet
