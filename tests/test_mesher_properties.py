@@ -248,3 +248,36 @@ def test_seed_flips_recover_most_missing_input_edges():
     assert st["seed_flips"] >= st["seed_recovered_edges"]
     _, box = core.tetrahedralize(s, {"bsp_seed": "box"})
     assert st["bsp_points"] * 10 < box["bsp_points"], (st["bsp_points"], box["bsp_points"])
+
+
+def fan_prism(n, h, a=3.0, b=1.0):
+    """A prism over an ellipse's n-gon, height h, its two caps fanned from one vertex (not their
+    Delaunay triangulation: the seed misses most fan edges, and they cross each other in the cap
+    planes), its sides split along one diagonal each."""
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    ring = np.c_[a * np.cos(t), b * np.sin(t)]
+    pts = np.vstack([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, h)]])
+    tris = []
+    for i in range(1, n - 1):
+        tris += [(0, i + 1, i), (n, n + i, n + i + 1)]
+    for i in range(n):
+        j = (i + 1) % n
+        tris += [(i, j, n + j), (i, n + j, n + i)]
+    return Surface(pts, np.array(tris))
+
+
+@pytest.mark.parametrize("n,h", [(12, 1.0), (40, 0.3), (64, 0.05), (64, 4.0)])
+def test_seed_planar_flips_on_fanned_caps(n, h):
+    """Planar flip sequences in the seed (edge removals of seed edges that fanned cap edges cross)
+    keep the complex exact: the mesh is valid, keeps the surface and has the prism's volume,
+    whether the flips recover an edge or stop part way."""
+    s = fan_prism(n, h)
+    mesh, st = core.tetrahedralize(s, {"bsp_seed": "delaunay"})
+    print(n, h, {k: v for k, v in st.items() if k.startswith("seed_")}, "BSP points", st["bsp_points"])
+    assert st["bsp_seed"] == "delaunay" and st["seed_missing_edges"] > 0
+    assert st["seed_flips"] > 0
+    report = core.check_mesh(s, mesh)
+    assert report["valid"], "; ".join(report["messages"])
+    assert report["boundary_steiner_points"] == 0
+    vol = core.signed_volume(s)
+    assert abs(mesh_volume(mesh) - vol) <= 1e-12 * vol

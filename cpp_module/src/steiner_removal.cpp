@@ -17,69 +17,6 @@ namespace bsptet {
 
 namespace {
 
-// The direction d (|d|_inf <= 1) that maximizes min_j m_j . d, by enumerating the vertices of the
-// 4-variable LP (d, s): max s, m_j . d >= s, -1 <= d_k <= 1. Small inputs only (a fallback).
-// Returns the margin s (<= 0: no direction sees every half-space).
-double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
-  struct Row {
-    double a[4], b;  // a . (d, s) = b when active
-  };
-  std::vector<Row> rows;
-  for (const Vec3& m : ms) rows.push_back({{m.x, m.y, m.z, -1.0}, 0.0});
-  for (int k = 0; k < 3; ++k)
-    for (double sg : {1.0, -1.0}) {
-      Row r{{0, 0, 0, 0}, 1.0};
-      r.a[k] = sg;
-      rows.push_back(r);
-    }
-  const std::size_t n = rows.size();
-  double best_s = -INFINITY;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 1; j < n; ++j)
-      for (std::size_t k = j + 1; k < n; ++k)
-        for (std::size_t l = k + 1; l < n; ++l) {
-          double A[4][5];
-          const std::size_t idx[4] = {i, j, k, l};
-          for (int r = 0; r < 4; ++r) {
-            for (int c = 0; c < 4; ++c) A[r][c] = rows[idx[r]].a[c];
-            A[r][4] = rows[idx[r]].b;
-          }
-          bool singular = false;
-          for (int c = 0; c < 4 && !singular; ++c) {
-            int piv = c;
-            for (int r = c + 1; r < 4; ++r)
-              if (std::fabs(A[r][c]) > std::fabs(A[piv][c])) piv = r;
-            if (std::fabs(A[piv][c]) < 1e-12) {
-              singular = true;
-              break;
-            }
-            for (int cc = 0; cc < 5; ++cc) std::swap(A[c][cc], A[piv][cc]);
-            for (int r = 0; r < 4; ++r)
-              if (r != c) {
-                const double f = A[r][c] / A[c][c];
-                for (int cc = c; cc < 5; ++cc) A[r][cc] -= f * A[c][cc];
-              }
-          }
-          if (singular) continue;
-          const double x[4] = {A[0][4] / A[0][0], A[1][4] / A[1][1], A[2][4] / A[2][2], A[3][4] / A[3][3]};
-          if (!(x[3] > best_s)) continue;
-          bool feasible = true;
-          for (const Row& r : rows) {
-            const double lhs = r.a[0] * x[0] + r.a[1] * x[1] + r.a[2] * x[2] + r.a[3] * x[3];
-            // m . d - s >= 0 for half-spaces; |d_k| <= 1 for the box (a . x <= b).
-            if (r.a[3] != 0 ? lhs < -1e-12 : lhs > r.b + 1e-12) {
-              feasible = false;
-              break;
-            }
-          }
-          if (feasible) {
-            best_s = x[3];
-            *best = {x[0], x[1], x[2]};
-          }
-        }
-  return best_s;
-}
-
 // The Chebyshev centre of a convex polytope {u : m_j . u >= d_j for all j} (m_j unit normals,
 // coordinates relative to some origin) clipped to the box |u_k| <= R: the point u that maximizes
 // its clearance s = min_j (m_j . u - d_j). Solved in doubles (a heuristic: every use is followed by
@@ -177,6 +114,17 @@ double chebyshev_centre(const std::vector<std::pair<Vec3, double>>& hs, double R
   double s = INFINITY;  // the clearance actually reached (recomputed, not trusted from the LP)
   for (const auto& [m, d] : hs) s = std::min(s, m.x * out->x + m.y * out->y + m.z * out->z - d);
   return s;
+}
+
+// The direction d (|d|_inf <= 1) that maximizes min_j m_j . d: the Chebyshev centre of the cone
+// {u : m_j . u >= 0} clipped to the box |u_k| <= 1 (the same LP; its extra row s <= 1 only caps a
+// margin no unit normal reaches beyond sqrt 3). A heuristic in doubles: every candidate it yields
+// is checked exactly. Returns the margin (<= 0, or -inf when the simplex fails: no direction).
+double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
+  std::vector<std::pair<Vec3, double>> hs;
+  hs.reserve(ms.size());
+  for (const Vec3& m : ms) hs.push_back({m, 0.0});
+  return chebyshev_centre(hs, 1.0, best);
 }
 
 // Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face (a
