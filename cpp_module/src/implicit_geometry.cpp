@@ -212,6 +212,15 @@ Sign ImplicitGeometry::side(Index p, Index v) {
     if (vx.explicit_id == pd.a || vx.explicit_id == pd.b || vx.explicit_id == pd.c) return Sign::kZero;
     return ::bsptet::orient3d(points_[pd.a], points_[pd.b], points_[pd.c], points_[vx.explicit_id]);
   }
+  {
+    // side = orient3d(a, b, c, v) over the plane's explicit points; v within r of m.
+    Vec3 m;
+    double r;
+    Sign s;
+    if (approximate(v, &m, &r) &&
+        orient3d_uncertain(points_[pd.a], 0, points_[pd.b], 0, points_[pd.c], 0, m, r, s))
+      return s;
+  }
   prepare_plane(p);
   const PlaneCache& c = plane_cache_[p];
   const auto& h = vertex_interval(v);
@@ -269,11 +278,43 @@ Sign ImplicitGeometry::side_of_box(Index p, const std::array<Interval, 3>& b) {
   return s > 0 ? Sign::kPositive : s < 0 ? Sign::kNegative : Sign::kZero;
 }
 
+bool ImplicitGeometry::approximate(Index v, Vec3* m, double* r) {
+  const Vertex& vx = verts_[v];
+  if (vx.explicit_id >= 0) {
+    *m = points_[vx.explicit_id];
+    *r = 0;
+    return true;
+  }
+  const auto* b = box(v);
+  if (!b) return false;
+  // m in [lo, hi] (halving is exact but for subnormals, and rounding is monotone), so its distance
+  // to the exact coordinate is at most hi - lo (plus 2^-1073 for the subnormal case); fl(hi - lo)
+  // errs by at most u, covered by the factor.
+  double width = 0, c[3];
+  for (int k = 0; k < 3; ++k) {
+    const double lo = (*b)[k].lo(), hi = (*b)[k].hi();
+    c[k] = 0.5 * lo + 0.5 * hi;
+    width = std::max(width, hi - lo);
+  }
+  *m = {c[0], c[1], c[2]};
+  *r = width * (1 + 0x1p-50) + 0x1p-1060;
+  return std::isfinite(*r) && std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]);
+}
+
 Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)
     return ::bsptet::orient3d(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
                             points_[vd.explicit_id]);
+  {
+    // First filter: doubles with the points' error radii (no interval arithmetic).
+    Vec3 pa, pb, pc, pd;
+    double ra, rb, rc, rd;
+    Sign s;
+    if (approximate(a, &pa, &ra) && approximate(b, &pb, &rb) && approximate(c, &pc, &rc) &&
+        approximate(d, &pd, &rd) && orient3d_uncertain(pa, ra, pb, rb, pc, rc, pd, rd, s))
+      return s;
+  }
   {
     const auto *ba = box(a), *bb = box(b), *bc = box(c), *bd = box(d);
     if (ba && bb && bc && bd) {
@@ -331,6 +372,14 @@ Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0)
     return orient2d_projected(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id], axis);
+  {
+    Vec3 pa, pb, pc;
+    double ra, rb, rc;
+    Sign s;
+    if (approximate(a, &pa, &ra) && approximate(b, &pb, &rb) && approximate(c, &pc, &rc) &&
+        orient2d_uncertain(pa, ra, pb, rb, pc, rc, axis, s))
+      return s;
+  }
   {
     const auto *ba = box(a), *bb = box(b), *bc = box(c);
     if (ba && bb && bc) {

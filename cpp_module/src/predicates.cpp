@@ -218,6 +218,57 @@ Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return orient3d_exact(a, b, c, d);
 }
 
+namespace {
+// |U_k - u_k| for the computed difference u_k = fl(B_k - A_k) of approximations A, B within ra,
+// rb of the exact points: (ra + rb) + u |B_k - A_k|, with |B_k - A_k| <= |u_k| (1 + 2u), computed
+// and then inflated so that its own rounding cannot make it smaller than the bound.
+inline double difference_error(double ra, double rb, double uk) {
+  return ((ra + rb) + 0x1p-52 * std::fabs(uk)) * (1 + 0x1p-50);
+}
+}  // namespace
+
+bool orient3d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, const Vec3& c, double rc, const Vec3& d,
+                        double rd, Sign& out) {
+  const double u[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, v[3] = {c.x - a.x, c.y - a.y, c.z - a.z},
+               w[3] = {d.x - a.x, d.y - a.y, d.z - a.z};
+  double au[3], av[3], aw[3], bu[3], bv[3], bw[3];  // |x| and |x| + its error bound
+  for (int k = 0; k < 3; ++k) {
+    au[k] = std::fabs(u[k]), av[k] = std::fabs(v[k]), aw[k] = std::fabs(w[k]);
+    bu[k] = au[k] + difference_error(ra, rb, u[k]);
+    bv[k] = av[k] + difference_error(ra, rc, v[k]);
+    bw[k] = aw[k] + difference_error(ra, rd, w[k]);
+  }
+  const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                     u[2] * (v[0] * w[1] - v[1] * w[0]);
+  auto perm = [](const double* x, const double* y, const double* z) {
+    return x[0] * (y[1] * z[2] + y[2] * z[1]) + x[1] * (y[0] * z[2] + y[2] * z[0]) + x[2] * (y[0] * z[1] + y[1] * z[0]);
+  };
+  const double p0 = perm(au, av, aw), p1 = perm(bu, bv, bw);
+  // |det(exact) - det| <= (P1 - P0) (input errors; det is multilinear) + 8u P0 (evaluation), with
+  // P0, P1 the permanents without and with the errors, each computed within 6u; the last terms
+  // cover the rounding of this bound's own three operations (each <= u P1).
+  const double bound = p1 * (1 + 12 * kUnitRoundoff) - p0 * (1 - 16 * kUnitRoundoff);
+  if (!(std::isfinite(p1) && std::isfinite(det) && p1 > kUnderflowGuard && std::fabs(det) > bound)) return false;
+  out = sign_of(det);
+  return true;
+}
+
+bool orient2d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, const Vec3& c, double rc, int axis,
+                        Sign& out) {
+  int ku = 0, kv = 0;
+  kept_axes(axis, ku, kv);
+  const double bu = b[ku] - a[ku], bv = b[kv] - a[kv], cu = c[ku] - a[ku], cv = c[kv] - a[kv];
+  const double l = bu * cv, r = bv * cu, det = l - r;
+  const double p0 = std::fabs(bu) * std::fabs(cv) + std::fabs(bv) * std::fabs(cu);
+  const double p1 = (std::fabs(bu) + difference_error(ra, rb, bu)) * (std::fabs(cv) + difference_error(ra, rc, cv)) +
+                    (std::fabs(bv) + difference_error(ra, rb, bv)) * (std::fabs(cu) + difference_error(ra, rc, cu));
+  // As orient3d_uncertain: P0, P1 within 3u, evaluation error <= 3u P0.
+  const double bound = p1 * (1 + 8 * kUnitRoundoff) - p0 * (1 - 10 * kUnitRoundoff);
+  if (!(std::isfinite(p1) && std::isfinite(det) && p1 > kUnderflowGuard && std::fabs(det) > bound)) return false;
+  out = sign_of(det);
+  return true;
+}
+
 bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out) {
   const Vec3* rows[4] = {&a, &b, &c, &d};
   double x[4], y[4], z[4], l[4], la[4];

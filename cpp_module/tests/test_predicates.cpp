@@ -228,3 +228,61 @@ TEST(LiftedFilters, AgreeWithExact) {
   EXPECT_GT(zeros, 1000);           // the degenerate cases were really made
   EXPECT_GT(certified, trials / 5);  // and the filter decides the random quarter (the rest is built degenerate)
 }
+
+// The filters for approximately known points: the exact points p are doubles (so the exact sign
+// is known), the filters see m = p moved by up to r in each coordinate (r from 0 to 1e-3 of the
+// scale). A certified sign must be the exact sign of the p; coplanar / collinear p (exact zeros)
+// must never be certified. Near-degenerate cases: a fourth point on the plane of three, moved one
+// ulp; scales from 2^-300 to 2^300.
+TEST(UncertainFilters, AgreeWithExactOfTheTruePoints) {
+  const unsigned seed = 20261204u;
+  std::printf("seed %u\n", seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1), U01(0, 1);
+  std::uniform_int_distribution<int> scale_exp(-300, 300), kind_of(0, 3), rexp(-60, -10);
+  int certified3 = 0, certified2 = 0, zeros = 0;
+  for (int it = 0; it < 60000; ++it) {
+    const int kind = kind_of(rng);
+    const double s = std::ldexp(1.0, kind == 3 ? scale_exp(rng) : 0);
+    Vec3 p[4];
+    for (auto& q : p) q = {U(rng) * s, U(rng) * s, U(rng) * s};
+    if (kind == 1 || kind == 2) {
+      // d on the plane of a, b, c (exactly when it lands on doubles: take d = a + k (b - a) with
+      // small integer k and exact differences), then maybe one ulp off.
+      const double k = static_cast<double>(1 + it % 3);
+      p[0] = {std::ldexp(std::round(U(rng) * 1024), -10) * s, std::ldexp(std::round(U(rng) * 1024), -10) * s,
+              std::ldexp(std::round(U(rng) * 1024), -10) * s};
+      p[1] = {p[0].x + std::ldexp(1.0, -3) * s, p[0].y, p[0].z + std::ldexp(1.0, -4) * s};
+      p[3] = {p[0].x + k * (p[1].x - p[0].x), p[0].y + k * (p[1].y - p[0].y), p[0].z + k * (p[1].z - p[0].z)};
+      if (kind == 2) p[3].y = std::nextafter(p[3].y, 10.0 * s);
+    }
+    const double r[4] = {kind_of(rng) == 0 ? 0.0 : std::ldexp(U01(rng), rexp(rng)) * s,
+                         kind_of(rng) == 0 ? 0.0 : std::ldexp(U01(rng), rexp(rng)) * s,
+                         kind_of(rng) == 0 ? 0.0 : std::ldexp(U01(rng), rexp(rng)) * s,
+                         kind_of(rng) == 0 ? 0.0 : std::ldexp(U01(rng), rexp(rng)) * s};
+    Vec3 m[4];
+    for (int i = 0; i < 4; ++i) m[i] = {p[i].x + r[i] * U(rng), p[i].y + r[i] * U(rng), p[i].z + r[i] * U(rng)};
+    // The perturbation itself rounds: recompute the radius that really holds.
+    double rr[4];
+    for (int i = 0; i < 4; ++i)
+      rr[i] = std::max({std::fabs(m[i].x - p[i].x), std::fabs(m[i].y - p[i].y), std::fabs(m[i].z - p[i].z)});
+    const Sign ex = orient3d_exact(p[0], p[1], p[2], p[3]);
+    zeros += ex == Sign::kZero;
+    Sign f;
+    if (orient3d_uncertain(m[0], rr[0], m[1], rr[1], m[2], rr[2], m[3], rr[3], f)) {
+      ++certified3;
+      ASSERT_EQ(f, ex) << "it " << it;
+    }
+    const int axis = it % 3;
+    const Sign ex2 = orient2d_projected_exact(p[0], p[1], p[3], axis);
+    if (orient2d_uncertain(m[0], rr[0], m[1], rr[1], m[3], rr[3], axis, f)) {
+      ++certified2;
+      ASSERT_EQ(f, ex2) << "it " << it;
+    }
+  }
+  std::printf("orient3d_uncertain certified %d, orient2d_uncertain %d, exact zeros %d of 60000\n", certified3,
+              certified2, zeros);
+  EXPECT_GT(zeros, 5000);
+  EXPECT_GT(certified3, 20000);
+  EXPECT_GT(certified2, 20000);
+}

@@ -133,6 +133,9 @@ class ImplicitGeometry {
   /// A sufficient condition for collinearity (no arithmetic): one of them is a TPI vertex and the
   /// other two lie on two of its defining planes.
   bool known_collinear(Index x, Index y, Index z) const;
+  /// A double point m with every coordinate within r of vertex v's exact one (explicit: the point
+  /// itself, r = 0; else the centre and width of box(v)); false when there is no box.
+  bool approximate(Index v, Vec3* m, double* r);
   /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
   /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
   const std::array<Interval, 3>* box(Index v);

@@ -34,6 +34,16 @@ Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int a
 /// [2^-200, 2^200] (orient3d then uses orient3d_exact).
 bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
 
+/// Filters for points known only approximately: each exact point lies within r (per coordinate)
+/// of the given double point (a TPI vertex's rounded coordinates and its enclosing box). True,
+/// and `out` set to the exact sign of orient3d / orient2d_projected of the exact points, when the
+/// double evaluation and the input errors provably cannot change it; false otherwise (decide
+/// exactly). With all r = 0 they are (slightly weaker) filters of orient3d / orient2d_projected.
+bool orient3d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, const Vec3& c, double rc, const Vec3& d,
+                        double rd, Sign& out);
+bool orient2d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, const Vec3& c, double rc, int axis,
+                        Sign& out);
+
 /// Floating-point filters of the lifted determinants of ImplicitGeometry::lifted_det3 / lifted_det2
 /// (unperturbed), for double points: lifted_det3 is sign det4 over the rows a..d of
 /// (p - e, |p - e|^2); lifted_det2 is sign det3 over the rows a..c of ((p - d) projected by
