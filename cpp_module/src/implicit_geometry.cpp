@@ -479,6 +479,14 @@ Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) 
                            points_[vd.explicit_id], points_[ve.explicit_id], s) &&
         s != Sign::kZero)
       return s;
+    std::array<Vec3, 4> m;
+    std::array<double, 4> r;
+    Vec3 me;
+    double re;
+    if (approximate(a, &m[0], &r[0]) && approximate(b, &m[1], &r[1]) && approximate(c, &m[2], &r[2]) &&
+        approximate(d, &m[3], &r[3]) && approximate(e, &me, &re) &&
+        lifted_det3_uncertain(m.data(), r.data(), me, re, s) && s != Sign::kZero)
+      return s;
   }
   int s0 = 0;
   const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d), *b4 = box(e);
@@ -545,6 +553,13 @@ Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis)
         lifted_det2_filter(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
                            points_[vd.explicit_id], axis, s) &&
         s != Sign::kZero)
+      return s;
+    std::array<Vec3, 3> m;
+    std::array<double, 3> r;
+    Vec3 md;
+    double rd;
+    if (approximate(a, &m[0], &r[0]) && approximate(b, &m[1], &r[1]) && approximate(c, &m[2], &r[2]) &&
+        approximate(d, &md, &rd) && lifted_det2_uncertain(m.data(), r.data(), md, rd, axis, s) && s != Sign::kZero)
       return s;
   }
   int s0 = 0;

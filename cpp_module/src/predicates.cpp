@@ -269,6 +269,71 @@ bool orient2d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, cons
   return true;
 }
 
+bool lifted_det3_uncertain(const Vec3* p, const double* rp, const Vec3& e, double re, Sign& out) {
+  double d[4][3], ad[4][3], bd[4][3], la[4], lb[4];
+  for (int i = 0; i < 4; ++i) {
+    const double di[3] = {p[i].x - e.x, p[i].y - e.y, p[i].z - e.z};
+    la[i] = lb[i] = 0;
+    for (int k = 0; k < 3; ++k) {
+      d[i][k] = di[k];
+      ad[i][k] = std::fabs(di[k]);
+      bd[i][k] = ad[i][k] + difference_error(rp[i], re, di[k]);
+      la[i] += di[k] * di[k];
+      lb[i] += bd[i][k] * bd[i][k];
+    }
+  }
+  // det3 over (x, y, z) of rows (i, j, k), and its permanent over the given magnitudes.
+  auto det3r = [&](int i, int j, int k) {
+    return d[i][0] * (d[j][1] * d[k][2] - d[j][2] * d[k][1]) - d[i][1] * (d[j][0] * d[k][2] - d[j][2] * d[k][0]) +
+           d[i][2] * (d[j][0] * d[k][1] - d[j][1] * d[k][0]);
+  };
+  auto perm3 = [](const double (*x)[3], int i, int j, int k) {
+    return x[i][0] * (x[j][1] * x[k][2] + x[j][2] * x[k][1]) + x[i][1] * (x[j][0] * x[k][2] + x[j][2] * x[k][0]) +
+           x[i][2] * (x[j][0] * x[k][1] + x[j][1] * x[k][0]);
+  };
+  // Laplace expansion on the lift column: cofactor signs -, +, -, + for rows 0..3.
+  const double det = ((la[1] * det3r(0, 2, 3) - la[0] * det3r(1, 2, 3)) + la[3] * det3r(0, 1, 2)) - la[2] * det3r(0, 1, 3);
+  const double pa = ((la[1] * perm3(ad, 0, 2, 3) + la[0] * perm3(ad, 1, 2, 3)) + la[3] * perm3(ad, 0, 1, 2)) +
+                    la[2] * perm3(ad, 0, 1, 3);
+  const double pb = ((lb[1] * perm3(bd, 0, 2, 3) + lb[0] * perm3(bd, 1, 2, 3)) + lb[3] * perm3(bd, 0, 1, 2)) +
+                    lb[2] * perm3(bd, 0, 1, 3);
+  // Per term, |L M - l m| <= Lb Mb - La Ma (|L - l| <= Lb - La, |M - m| <= Mb - Ma, |M| <= Mb);
+  // so the input errors move det by at most Pb - Pa, the evaluation by at most 16u Pa (as in
+  // lifted_det3_filter); Pa and Pb are computed within 10u, this bound's own rounding within 3u Pb.
+  const double bound = pb * (1 + 16 * kUnitRoundoff) - pa * (1 - 28 * kUnitRoundoff);
+  if (!(std::isfinite(pb) && std::isfinite(det) && pb > kUnderflowGuard && std::fabs(det) > bound)) return false;
+  out = sign_of(det);
+  return true;
+}
+
+bool lifted_det2_uncertain(const Vec3* p, const double* rp, const Vec3& e, double re, int axis, Sign& out) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  double du[3], dv[3], au[3], av[3], bu[3], bv[3], la[3], lb[3];
+  for (int i = 0; i < 3; ++i) {
+    const double di[3] = {p[i].x - e.x, p[i].y - e.y, p[i].z - e.z};
+    la[i] = lb[i] = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double b = std::fabs(di[k]) + difference_error(rp[i], re, di[k]);
+      la[i] += di[k] * di[k];
+      lb[i] += b * b;
+      if (k == u) du[i] = di[k], au[i] = std::fabs(di[k]), bu[i] = b;
+      if (k == v) dv[i] = di[k], av[i] = std::fabs(di[k]), bv[i] = b;
+    }
+  }
+  // det3 of rows (du, dv, l) expanded on the lift column: l0 m12 - l1 m02 + l2 m01 with the 2x2
+  // minors m_ij = du_i dv_j - dv_i du_j.
+  auto m = [&](int i, int j) { return du[i] * dv[j] - dv[i] * du[j]; };
+  auto pm = [](const double* x, const double* y, int i, int j) { return x[i] * y[j] + y[i] * x[j]; };
+  const double det = (la[0] * m(1, 2) - la[1] * m(0, 2)) + la[2] * m(0, 1);
+  const double pa = (la[0] * pm(au, av, 1, 2) + la[1] * pm(au, av, 0, 2)) + la[2] * pm(au, av, 0, 1);
+  const double pb = (lb[0] * pm(bu, bv, 1, 2) + lb[1] * pm(bu, bv, 0, 2)) + lb[2] * pm(bu, bv, 0, 1);
+  // As lifted_det3_uncertain (evaluation depth 9: 16u; Pa, Pb within 8u).
+  const double bound = pb * (1 + 14 * kUnitRoundoff) - pa * (1 - 26 * kUnitRoundoff);
+  if (!(std::isfinite(pb) && std::isfinite(det) && pb > kUnderflowGuard && std::fabs(det) > bound)) return false;
+  out = sign_of(det);
+  return true;
+}
+
 bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out) {
   const Vec3* rows[4] = {&a, &b, &c, &d};
   double x[4], y[4], z[4], l[4], la[4];

@@ -286,3 +286,70 @@ TEST(UncertainFilters, AgreeWithExactOfTheTruePoints) {
   EXPECT_GT(certified3, 20000);
   EXPECT_GT(certified2, 20000);
 }
+
+// The lifted filters for approximately known points, as above: exact double points (random, and
+// exactly cospherical / cocircular ones moved by one ulp), seen within radii up to 2^-10 of them.
+TEST(UncertainFilters, LiftedAgreeWithExactOfTheTruePoints) {
+  const unsigned seed = 20261205u;
+  std::printf("seed %u\n", seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1), U01(0, 1);
+  std::uniform_int_distribution<int> kind_of(0, 3), rexp(-60, -10);
+  const Vec3 sphere[] = {{3, 4, 0}, {-3, 4, 0}, {0, 3, 4}, {0, -3, 4}, {4, 0, 3}, {4, 0, -3}, {-4, 0, 3}, {0, 5, 0}};
+  int certified3 = 0, certified2 = 0, zeros = 0;
+  for (int it = 0; it < 40000; ++it) {
+    const int kind = it % 3;
+    Vec3 p[5];
+    for (int i = 0; i < 5; ++i) {
+      p[i] = kind == 0 ? Vec3{U(rng), U(rng), U(rng)} : sphere[(it * 7 + i * 3) % 8];
+      if (kind == 2 && i == 4) p[i].x = std::nextafter(p[i].x, 10.0);
+    }
+    double r[5];
+    Vec3 m[5];
+    for (int i = 0; i < 5; ++i) {
+      const double ri = kind_of(rng) == 0 ? 0.0 : std::ldexp(U01(rng), rexp(rng));
+      m[i] = {p[i].x + ri * U(rng), p[i].y + ri * U(rng), p[i].z + ri * U(rng)};
+      r[i] = std::max({std::fabs(m[i].x - p[i].x), std::fabs(m[i].y - p[i].y), std::fabs(m[i].z - p[i].z)});
+    }
+    Sign ex3, f;
+    ASSERT_TRUE(true);
+    {
+      ExactFloat q[4][4];
+      for (int i = 0; i < 4; ++i) {
+        const ExactFloat dx = ExactFloat(p[i].x) - ExactFloat(p[4].x), dy = ExactFloat(p[i].y) - ExactFloat(p[4].y),
+                         dz = ExactFloat(p[i].z) - ExactFloat(p[4].z);
+        q[i][0] = dx, q[i][1] = dy, q[i][2] = dz, q[i][3] = dx * dx + dy * dy + dz * dz;
+      }
+      auto mm = [&](int i, int j, int a, int b) { return q[i][a] * q[j][b] - q[i][b] * q[j][a]; };
+      const ExactFloat det = mm(0, 1, 0, 1) * mm(2, 3, 2, 3) - mm(0, 1, 0, 2) * mm(2, 3, 1, 3) +
+                             mm(0, 1, 0, 3) * mm(2, 3, 1, 2) + mm(0, 1, 1, 2) * mm(2, 3, 0, 3) -
+                             mm(0, 1, 1, 3) * mm(2, 3, 0, 2) + mm(0, 1, 2, 3) * mm(2, 3, 0, 1);
+      ex3 = det.sign() > 0 ? Sign::kPositive : det.sign() < 0 ? Sign::kNegative : Sign::kZero;
+    }
+    zeros += ex3 == Sign::kZero;
+    if (lifted_det3_uncertain(m, r, m[4], r[4], f)) {
+      ++certified3;
+      ASSERT_EQ(f, ex3) << "it " << it;
+    }
+    const int axis = it % 3, u = (axis + 1) % 3, v = (axis + 2) % 3;
+    ExactFloat q[3][3];
+    for (int i = 0; i < 3; ++i) {
+      const ExactFloat dd[3] = {ExactFloat(p[i].x) - ExactFloat(p[3].x), ExactFloat(p[i].y) - ExactFloat(p[3].y),
+                                ExactFloat(p[i].z) - ExactFloat(p[3].z)};
+      q[i][0] = dd[u], q[i][1] = dd[v], q[i][2] = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+    }
+    const ExactFloat det2 = q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1]) -
+                            q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0]) +
+                            q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0]);
+    const Sign ex2 = det2.sign() > 0 ? Sign::kPositive : det2.sign() < 0 ? Sign::kNegative : Sign::kZero;
+    if (lifted_det2_uncertain(m, r, m[3], r[3], axis, f)) {
+      ++certified2;
+      ASSERT_EQ(f, ex2) << "it " << it;
+    }
+  }
+  std::printf("lifted_det3_uncertain certified %d, lifted_det2_uncertain %d, exact zeros %d of 40000\n", certified3,
+              certified2, zeros);
+  EXPECT_GT(zeros, 5000);
+  EXPECT_GT(certified3, 10000);
+  EXPECT_GT(certified2, 10000);
+}
