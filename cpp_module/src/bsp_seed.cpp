@@ -615,8 +615,10 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   auto input_plane_of = [&](Index x, Index y, Index z) -> Index {
     for (Index w : {x, y, z}) {
       if (w >= corner0_) continue;
-      const std::vector<Index> planes = geo_.known_planes(w);  // copy: side() may note planes
-      for (Index q : planes) {
+      // By index, no copy: side() may note a plane (append to this list) for implicit vertices;
+      // these are explicit, and an appended plane would only be looked at too.
+      for (std::size_t k = 0; k < geo_.known_planes(w).size(); ++k) {
+        const Index q = geo_.known_planes(w)[k];
         if (q >= input_planes) continue;
         bool on = true;
         for (Index o : {x, y, z})
@@ -668,12 +670,12 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     s = e;
   }
   std::vector<Index> vertex_tet(static_cast<std::size_t>(corner0_ + 8), -1);
+  // A cell's face boxes are left to split_cell, which builds them when they are out of step:
+  // most seed tets are never split, and four boxes per tet were a fifth of the seed's memory.
   for (Index t = 0; t < nt; ++t) {
-    for (int i = 0; i < 4; ++i) {
-      cells_[t].faces.push_back(tet_face[t][i]);
-      cells_[t].boxes.push_back(face_box(tet_face[t][i]));
+    cells_[t].faces.assign(tet_face[t].begin(), tet_face[t].end());
+    for (int i = 0; i < 4; ++i)
       if (vertex_tet[tets[t][i]] < 0) vertex_tet[tets[t][i]] = t;
-    }
   }
 
   lap("seed_faces");
