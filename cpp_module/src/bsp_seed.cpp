@@ -610,6 +610,14 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   std::sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
     return a.key != b.key ? a.key < b.key : (a.tet != b.tet ? a.tet < b.tet : a.i < b.i);
   });
+  // Capacity for the seed and an eighth more for the splits: growing a vector doubles it (and
+  // holds old and new at once), which made these two vectors the peak of the BSP's memory.
+  {
+    std::size_t num_faces = 0;
+    for (std::size_t s = 0; s < slots.size(); ++s) num_faces += s == 0 || slots[s].key != slots[s - 1].key;
+    faces_.reserve(faces_.size() + num_faces + num_faces / 8);
+    cells_.reserve(static_cast<std::size_t>(nt) + static_cast<std::size_t>(nt) / 8);
+  }
   cells_.assign(static_cast<std::size_t>(nt), BspCell{});
   std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1}), nb(nt, {-1, -1, -1, -1});
   auto input_plane_of = [&](Index x, Index y, Index z) -> Index {

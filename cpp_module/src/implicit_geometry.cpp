@@ -74,7 +74,7 @@ ImplicitGeometry::ImplicitGeometry(std::vector<Vec3> explicit_points) : points_(
 Index ImplicitGeometry::add_plane(Index a, Index b, Index c) {
   const Index id = static_cast<Index>(planes_.size());
   planes_.push_back({a, b, c});
-  plane_cache_.emplace_back();
+  plane_cache_.emplace_back();  // null until prepare_plane: most planes (seed faces) never need it
   if (projection_axis(id) < 0)
     throw MeshingError(ErrorCode::kInternal, "geometry", id, "plane through collinear points");
   return id;
@@ -133,7 +133,8 @@ void ImplicitGeometry::note_on_plane(Index v, Index p) {
 }
 
 void ImplicitGeometry::prepare_plane(Index p) {
-  PlaneCache& c = plane_cache_[p];
+  if (!plane_cache_[p]) plane_cache_[p] = std::make_unique<PlaneCache>();
+  PlaneCache& c = *plane_cache_[p];
   if (c.ready) return;
   const PlaneDef& pd = planes_[p];
   plane_coefficients<Interval>(points_[pd.a], points_[pd.b], points_[pd.c], c.n_iv, c.d_iv);
@@ -141,7 +142,8 @@ void ImplicitGeometry::prepare_plane(Index p) {
 }
 
 const std::array<ExactFloat, 4>& ImplicitGeometry::plane_exact(Index p) {
-  PlaneCache& c = plane_cache_[p];
+  prepare_plane(p);
+  PlaneCache& c = *plane_cache_[p];
   if (!c.exact) {
     const PlaneDef& pd = planes_[p];
     std::array<ExactFloat, 3> n;
@@ -167,7 +169,7 @@ const std::array<Interval, 4>& ImplicitGeometry::vertex_interval(Index v) {
       Interval nd[3][4];
       for (int i = 0; i < 3; ++i) {
         prepare_plane(vx.planes[i]);
-        const PlaneCache& c = plane_cache_[vx.planes[i]];
+        const PlaneCache& c = *plane_cache_[vx.planes[i]];
         for (int k = 0; k < 3; ++k) nd[i][k] = c.n_iv[k];
         nd[i][3] = c.d_iv;
       }
@@ -222,7 +224,7 @@ Sign ImplicitGeometry::side(Index p, Index v) {
       return s;
   }
   prepare_plane(p);
-  const PlaneCache& c = plane_cache_[p];
+  const PlaneCache& c = *plane_cache_[p];
   const auto& h = vertex_interval(v);
   const Interval nd[4] = {c.n_iv[0], c.n_iv[1], c.n_iv[2], c.d_iv};
   const int s = side_value<Interval>(nd, h).certain_sign();
@@ -238,7 +240,7 @@ Sign ImplicitGeometry::side(Index p, Index v) {
 
 Sign ImplicitGeometry::side_of_box(Index p, const std::array<Interval, 3>& b) {
   prepare_plane(p);
-  const PlaneCache& c = plane_cache_[p];
+  const PlaneCache& c = *plane_cache_[p];
   // Bounds of n . x - d over the box in plain doubles, then one error bound for all the rounding:
   // each of the (at most) 7 operations per bound errs by at most 2^-53 of a partial result, and
   // every partial result is at most M = sum of the terms' magnitudes, so 2^-50 M covers it; 1e-300

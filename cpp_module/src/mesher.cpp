@@ -233,14 +233,22 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   bsp.identify_input_vertices(before_refinement);
   stage_time("bsp", t0);
 
-  t0 = Clock::now();
-  progress("inside / outside", 0);
-  const CellLabels labels = classify_cells(bsp);
-  stage_time("classify", t0);
+  CellTets cell_tets;
+  {
+    t0 = Clock::now();
+    progress("inside / outside", 0);
+    const CellLabels labels = classify_cells(bsp);
+    stage_time("classify", t0);
 
-  t0 = Clock::now();
-  progress("tetrahedralizing cells", 0);
-  const CellTets cell_tets = tetrahedralize_cells(bsp, labels, options.cone_cells ? CellFill::kCone : CellFill::kDelaunay);
+    t0 = Clock::now();
+    progress("tetrahedralizing cells", 0);
+    cell_tets = tetrahedralize_cells(bsp, labels, options.cone_cells ? CellFill::kCone : CellFill::kDelaunay);
+  }
+  // The complex is not needed any more: free it before the Steiner removal builds its own mesh
+  // (the two together made the peak memory). Its figures and the triangles' planes are kept.
+  const BspStats bsp_stats = bsp.stats();
+  const std::vector<Index> triangle_planes = bsp.triangle_planes();
+  complex.reset();
   stage_time("cell_tets", t0);
 
   t0 = Clock::now();
@@ -251,7 +259,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   so.progress = [&](double f) { progress("removing Steiner points", f); };
   SteinerRemovalStats ss;
   const std::vector<std::array<Index, 4>> tets =
-      remove_steiner_points(geo, surface, bsp.triangle_planes(), cell_tets, so, &ss);
+      remove_steiner_points(geo, surface, triangle_planes, cell_tets, so, &ss);
   stage_time("steiner_removal", t0);
 
   t0 = Clock::now();
@@ -276,10 +284,10 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   st.delaunay_cells = cell_tets.delaunay_cells;
   st.delaunay_recovered_cells = cell_tets.recovered_cells;
   st.delaunay_fallback_cells = cell_tets.delaunay_fallback_cells;
-  st.bsp_nodes = 2 * bsp.stats().splits + (st.delaunay_seeded ? bsp.stats().seed_tets : 1);
-  st.convex_cells = bsp.stats().leaves;
+  st.bsp_nodes = 2 * bsp_stats.splits + (st.delaunay_seeded ? bsp_stats.seed_tets : 1);
+  st.convex_cells = bsp_stats.leaves;
   st.inside_cells = cell_tets.inside_cells;
-  st.bsp_points = bsp.stats().bsp_points;
+  st.bsp_points = bsp_stats.bsp_points;
   st.exact_fallbacks = geo.exact_fallbacks();
   st.seconds_total = std::chrono::duration<double>(Clock::now() - t_start).count();
   if (stats) *stats = st;

@@ -146,7 +146,7 @@ class ImplicitGeometry {
 
   std::vector<Vec3> points_;
   std::vector<PlaneDef> planes_;
-  std::vector<PlaneCache> plane_cache_;
+  std::vector<std::unique_ptr<PlaneCache>> plane_cache_;  ///< allocated by prepare_plane
   std::vector<Vertex> verts_;
   long long exact_fallbacks_ = 0;
 };
