@@ -588,24 +588,39 @@ class TetComplex {
       // beyond it into the cavity (never across the surface), a few times at most.
       std::vector<Index> cav = cavity;
       std::vector<FacePair> boundary = cavity_boundary;
-      std::vector<std::array<Index, 3>> bs = bases;
+      // Per boundary face (parallel to `boundary`) and per new surface face: does w see it (-1 not
+      // decided yet). Kept across the growth steps (a face stays on the boundary until a tet
+      // beyond it joins), so each face is decided once, in the order of the faces (the order
+      // the cone's tets are made in).
+      std::vector<signed char> seen(boundary.size(), -1), seen_new(new_faces.size(), -1);
       std::vector<std::array<Index, 4>> repl;
+      std::vector<std::array<Index, 3>> bad;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
-      SeesFace sees(geo_, wid, max_grow > 0, &work);
+      auto sees = [&](const std::array<Index, 3>& f) {
+        ++work;
+        return geo_.orient3d(f[0], f[2], f[1], wid) == Sign::kPositive;
+      };
       for (int grow = 0; grow <= max_grow; ++grow) {
-        // Cone from w; every face w does not see takes the tet beyond it into the cavity.
+        // Cone from w over the cavity's bases (its boundary faces without a removed point, then
+        // the new surface faces); every face w does not see takes the tet beyond it into the cavity.
         repl.clear();
-        std::vector<std::array<Index, 3>> bad;
-        for (const auto& f : bs) {
-          const std::array<Index, 4> t{f[0], f[2], f[1], wid};
-          if (!sees(f)) {
+        bad.clear();
+        bool stop = false;
+        auto visit = [&](const std::array<Index, 3>& f, signed char& known) {
+          if (known < 0) known = sees(f) ? 1 : 0;
+          if (known == 0) {
             bad.push_back(f);
-            if (grow == max_grow) break;  // no growth left: one bad face decides
+            if (grow == max_grow) stop = true;  // no growth left: one bad face decides
           } else {
-            repl.push_back(t);
+            repl.push_back({f[0], f[2], f[1], wid});
           }
+        };
+        for (std::size_t i = 0; i < boundary.size() && !stop; ++i) {
+          const auto& f = boundary[i].second;
+          if (!is_removed(f[0]) && !is_removed(f[1]) && !is_removed(f[2])) visit(f, seen[i]);
         }
+        for (std::size_t i = 0; i < new_faces.size() && !stop; ++i) visit(new_faces[i], seen_new[i]);
         if (bad.empty()) {
           ok = true;
           break;
@@ -623,10 +638,9 @@ class TetComplex {
         if (add.empty() || cav.size() + add.size() > max_cavity) break;
         std::sort(add.begin(), add.end());
         add.erase(std::unique(add.begin(), add.end()), add.end());
-        boundary = merge_boundaries(boundary, boundary_pairs(add));
+        merge_boundaries_keeping(boundary, seen, boundary_pairs(add));
         cav.insert(cav.end(), add.begin(), add.end());
         std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
-        bs = cavity_bases(boundary);
         work += static_cast<std::int64_t>(boundary.size() + cav.size());  // the growth's own cost
       }
       if (!ok) continue;
@@ -959,6 +973,25 @@ class TetComplex {
   /// The boundary of the union of two sets of tets without common tets, from their boundaries
   /// (boundary_pairs order): the faces of one of them only (a face of both is now inside). A
   /// cavity that grows by a few tets updates its boundary this way instead of sorting it again.
+  /// merge_boundaries in place, with a value per face of `a` (`flags`, parallel to it) kept
+  /// for the faces that stay and -1 for the faces that come from b.
+  static void merge_boundaries_keeping(std::vector<FacePair>& a, std::vector<signed char>& flags,
+                                       const std::vector<FacePair>& b) {
+    std::vector<FacePair> out;
+    std::vector<signed char> out_flags;
+    out.reserve(a.size() + b.size());
+    out_flags.reserve(a.size() + b.size());
+    std::size_t i = 0, j = 0;
+    while (i < a.size() && j < b.size()) {
+      if (a[i].first < b[j].first) out.push_back(a[i]), out_flags.push_back(flags[i++]);
+      else if (b[j].first < a[i].first) out.push_back(b[j++]), out_flags.push_back(-1);
+      else ++i, ++j;
+    }
+    for (; i < a.size(); ++i) out.push_back(a[i]), out_flags.push_back(flags[i]);
+    for (; j < b.size(); ++j) out.push_back(b[j]), out_flags.push_back(-1);
+    a.swap(out);
+    flags.swap(out_flags);
+  }
   static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b) {
     std::vector<FacePair> out;
     out.reserve(a.size() + b.size());
