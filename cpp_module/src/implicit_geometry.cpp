@@ -303,6 +303,14 @@ bool ImplicitGeometry::approximate(Index v, Vec3* m, double* r) {
   return std::isfinite(*r) && std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]);
 }
 
+template <std::size_t N>
+bool ImplicitGeometry::approximate_all(const std::array<Index, N>& ids, std::array<Vec3, N>& m,
+                                       std::array<double, N>& r) {
+  for (std::size_t i = 0; i < N; ++i)
+    if (!approximate(ids[i], &m[i], &r[i])) return false;
+  return true;
+}
+
 Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
   const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0)
@@ -310,11 +318,10 @@ Sign ImplicitGeometry::orient3d(Index a, Index b, Index c, Index d) {
                             points_[vd.explicit_id]);
   {
     // First filter: doubles with the points' error radii (no interval arithmetic).
-    Vec3 pa, pb, pc, pd;
-    double ra, rb, rc, rd;
+    std::array<Vec3, 4> m;
+    std::array<double, 4> r;
     Sign s;
-    if (approximate(a, &pa, &ra) && approximate(b, &pb, &rb) && approximate(c, &pc, &rc) &&
-        approximate(d, &pd, &rd) && orient3d_uncertain(pa, ra, pb, rb, pc, rc, pd, rd, s))
+    if (approximate_all<4>({a, b, c, d}, m, r) && orient3d_uncertain(m[0], r[0], m[1], r[1], m[2], r[2], m[3], r[3], s))
       return s;
   }
   {
@@ -375,11 +382,10 @@ Sign ImplicitGeometry::orient2d(Index a, Index b, Index c, int axis) {
   if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0)
     return orient2d_projected(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id], axis);
   {
-    Vec3 pa, pb, pc;
-    double ra, rb, rc;
+    std::array<Vec3, 3> m;
+    std::array<double, 3> r;
     Sign s;
-    if (approximate(a, &pa, &ra) && approximate(b, &pb, &rb) && approximate(c, &pc, &rc) &&
-        orient2d_uncertain(pa, ra, pb, rb, pc, rc, axis, s))
+    if (approximate_all<3>({a, b, c}, m, r) && orient2d_uncertain(m[0], r[0], m[1], r[1], m[2], r[2], axis, s))
       return s;
   }
   {
@@ -473,22 +479,17 @@ std::array<T, 3> lifted_row2(const std::array<T, 4>& p, const std::array<T, 4>& 
 Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) {
   const std::array<Index, 5> ids{{a, b, c, d, e}};
   {
-    const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d], &ve = verts_[e];
+    // First filter: plain doubles when all five are explicit, else doubles with error radii.
+    std::array<Vec3, 5> m;
+    std::array<double, 5> r;
     Sign s;
-    if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0 &&
-        ve.explicit_id >= 0 &&
-        lifted_det3_filter(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
-                           points_[vd.explicit_id], points_[ve.explicit_id], s) &&
-        s != Sign::kZero)
-      return s;
-    std::array<Vec3, 4> m;
-    std::array<double, 4> r;
-    Vec3 me;
-    double re;
-    if (approximate(a, &m[0], &r[0]) && approximate(b, &m[1], &r[1]) && approximate(c, &m[2], &r[2]) &&
-        approximate(d, &m[3], &r[3]) && approximate(e, &me, &re) &&
-        lifted_det3_uncertain(m.data(), r.data(), me, re, s) && s != Sign::kZero)
-      return s;
+    if (approximate_all(ids, m, r)) {
+      const bool exact = r[0] == 0 && r[1] == 0 && r[2] == 0 && r[3] == 0 && r[4] == 0;
+      if ((exact ? lifted_det3_filter(m[0], m[1], m[2], m[3], m[4], s)
+                 : lifted_det3_uncertain(m.data(), r.data(), m[4], r[4], s)) &&
+          s != Sign::kZero)
+        return s;
+    }
   }
   int s0 = 0;
   const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d), *b4 = box(e);
@@ -549,20 +550,16 @@ Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis)
   const std::array<Index, 4> ids{{a, b, c, d}};
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   {
-    const Vertex &va = verts_[a], &vb = verts_[b], &vc = verts_[c], &vd = verts_[d];
+    std::array<Vec3, 4> m;
+    std::array<double, 4> r;
     Sign s;
-    if (va.explicit_id >= 0 && vb.explicit_id >= 0 && vc.explicit_id >= 0 && vd.explicit_id >= 0 &&
-        lifted_det2_filter(points_[va.explicit_id], points_[vb.explicit_id], points_[vc.explicit_id],
-                           points_[vd.explicit_id], axis, s) &&
-        s != Sign::kZero)
-      return s;
-    std::array<Vec3, 3> m;
-    std::array<double, 3> r;
-    Vec3 md;
-    double rd;
-    if (approximate(a, &m[0], &r[0]) && approximate(b, &m[1], &r[1]) && approximate(c, &m[2], &r[2]) &&
-        approximate(d, &md, &rd) && lifted_det2_uncertain(m.data(), r.data(), md, rd, axis, s) && s != Sign::kZero)
-      return s;
+    if (approximate_all(ids, m, r)) {
+      const bool exact = r[0] == 0 && r[1] == 0 && r[2] == 0 && r[3] == 0;
+      if ((exact ? lifted_det2_filter(m[0], m[1], m[2], m[3], axis, s)
+                 : lifted_det2_uncertain(m.data(), r.data(), m[3], r[3], axis, s)) &&
+          s != Sign::kZero)
+        return s;
+    }
   }
   int s0 = 0;
   const auto *b0 = box(a), *b1 = box(b), *b2 = box(c), *b3 = box(d);

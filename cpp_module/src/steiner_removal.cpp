@@ -638,7 +638,7 @@ class TetComplex {
         if (add.empty() || cav.size() + add.size() > max_cavity) break;
         std::sort(add.begin(), add.end());
         add.erase(std::unique(add.begin(), add.end()), add.end());
-        merge_boundaries_keeping(boundary, seen, boundary_pairs(add));
+        boundary = merge_boundaries(boundary, boundary_pairs(add), &seen);
         cav.insert(cav.end(), add.begin(), add.end());
         std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
         work += static_cast<std::int64_t>(boundary.size() + cav.size());  // the growth's own cost
@@ -973,36 +973,30 @@ class TetComplex {
   /// The boundary of the union of two sets of tets without common tets, from their boundaries
   /// (boundary_pairs order): the faces of one of them only (a face of both is now inside). A
   /// cavity that grows by a few tets updates its boundary this way instead of sorting it again.
-  /// merge_boundaries in place, with a value per face of `a` (`flags`, parallel to it) kept
-  /// for the faces that stay and -1 for the faces that come from b.
-  static void merge_boundaries_keeping(std::vector<FacePair>& a, std::vector<signed char>& flags,
-                                       const std::vector<FacePair>& b) {
+  /// `flags` (optional, parallel to a) is carried along: kept for a's faces that stay, -1 for b's.
+  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b,
+                                                std::vector<signed char>* flags = nullptr) {
     std::vector<FacePair> out;
     std::vector<signed char> out_flags;
     out.reserve(a.size() + b.size());
-    out_flags.reserve(a.size() + b.size());
+    if (flags) out_flags.reserve(a.size() + b.size());
+    auto take_a = [&](std::size_t i) {
+      out.push_back(a[i]);
+      if (flags) out_flags.push_back((*flags)[i]);
+    };
+    auto take_b = [&](std::size_t j) {
+      out.push_back(b[j]);
+      if (flags) out_flags.push_back(-1);
+    };
     std::size_t i = 0, j = 0;
     while (i < a.size() && j < b.size()) {
-      if (a[i].first < b[j].first) out.push_back(a[i]), out_flags.push_back(flags[i++]);
-      else if (b[j].first < a[i].first) out.push_back(b[j++]), out_flags.push_back(-1);
+      if (a[i].first < b[j].first) take_a(i++);
+      else if (b[j].first < a[i].first) take_b(j++);
       else ++i, ++j;
     }
-    for (; i < a.size(); ++i) out.push_back(a[i]), out_flags.push_back(flags[i]);
-    for (; j < b.size(); ++j) out.push_back(b[j]), out_flags.push_back(-1);
-    a.swap(out);
-    flags.swap(out_flags);
-  }
-  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b) {
-    std::vector<FacePair> out;
-    out.reserve(a.size() + b.size());
-    std::size_t i = 0, j = 0;
-    while (i < a.size() && j < b.size()) {
-      if (a[i].first < b[j].first) out.push_back(a[i++]);
-      else if (b[j].first < a[i].first) out.push_back(b[j++]);
-      else ++i, ++j;
-    }
-    out.insert(out.end(), a.begin() + static_cast<std::ptrdiff_t>(i), a.end());
-    out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(j), b.end());
+    for (; i < a.size(); ++i) take_a(i);
+    for (; j < b.size(); ++j) take_b(j);
+    if (flags) flags->swap(out_flags);
     return out;
   }
   /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.

@@ -159,6 +159,41 @@ TEST(Orient2dProjected, FilterAgreesWithExact) {
   }
 }
 
+namespace {
+
+// The lifted determinants of lifted_det3_filter / lifted_det2_filter computed in ExactFloat: det4
+// over the rows p[0..3] of (p - e, |p - e|^2), and det3 over the rows p[0..2] of ((p - d)
+// projected by `axis`, |p - d|^2). Their signs (-1, 0, +1).
+int exact_lifted_det3(const Vec3* p, const Vec3& e) {
+  ExactFloat r[4][4];
+  for (int i = 0; i < 4; ++i) {
+    const ExactFloat dx = ExactFloat(p[i].x) - ExactFloat(e.x), dy = ExactFloat(p[i].y) - ExactFloat(e.y),
+                     dz = ExactFloat(p[i].z) - ExactFloat(e.z);
+    r[i][0] = dx, r[i][1] = dy, r[i][2] = dz, r[i][3] = dx * dx + dy * dy + dz * dz;
+  }
+  auto m = [&](int i, int j, int a, int b) { return r[i][a] * r[j][b] - r[i][b] * r[j][a]; };
+  const ExactFloat det = m(0, 1, 0, 1) * m(2, 3, 2, 3) - m(0, 1, 0, 2) * m(2, 3, 1, 3) + m(0, 1, 0, 3) * m(2, 3, 1, 2) +
+                         m(0, 1, 1, 2) * m(2, 3, 0, 3) - m(0, 1, 1, 3) * m(2, 3, 0, 2) + m(0, 1, 2, 3) * m(2, 3, 0, 1);
+  return det.sign();
+}
+int exact_lifted_det2(const Vec3* p, const Vec3& d, int axis) {
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  ExactFloat r[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const ExactFloat dd[3] = {ExactFloat(p[i].x) - ExactFloat(d.x), ExactFloat(p[i].y) - ExactFloat(d.y),
+                              ExactFloat(p[i].z) - ExactFloat(d.z)};
+    r[i][0] = dd[u], r[i][1] = dd[v], r[i][2] = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+  }
+  const ExactFloat det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
+                         r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+                         r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+  return det.sign();
+}
+// Exactly cospherical points: (+-3, +-4, 0), (0, +-3, +-4), (+-4, 0, +-3) on the sphere of radius 5.
+const Vec3 kCospherical[8] = {{3, 4, 0}, {-3, 4, 0}, {0, 3, 4}, {0, -3, 4}, {4, 0, 3}, {4, 0, -3}, {-4, 0, 3}, {0, 5, 0}};
+
+}  // namespace
+
 // The lifted (in-sphere / in-circle) filters against ExactFloat: random points, points on a
 // common sphere (integer Pythagorean-like coordinates, exactly cospherical) moved by one ulp or
 // 2^-45, and scales from 2^-300 to 2^300. A certified sign must be the exact one; a zero
@@ -169,34 +204,6 @@ TEST(LiftedFilters, AgreeWithExact) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(-1, 1);
   std::uniform_int_distribution<int> scale_exp(-300, 300), pick(0, 3);
-  auto exact3 = [](const Vec3* p, const Vec3& e) {
-    ExactFloat r[4][4];
-    for (int i = 0; i < 4; ++i) {
-      const ExactFloat dx = ExactFloat(p[i].x) - ExactFloat(e.x), dy = ExactFloat(p[i].y) - ExactFloat(e.y),
-                       dz = ExactFloat(p[i].z) - ExactFloat(e.z);
-      r[i][0] = dx, r[i][1] = dy, r[i][2] = dz, r[i][3] = dx * dx + dy * dy + dz * dz;
-    }
-    auto m = [&](int i, int j, int a, int b) { return r[i][a] * r[j][b] - r[i][b] * r[j][a]; };
-    const ExactFloat det = m(0, 1, 0, 1) * m(2, 3, 2, 3) - m(0, 1, 0, 2) * m(2, 3, 1, 3) +
-                           m(0, 1, 0, 3) * m(2, 3, 1, 2) + m(0, 1, 1, 2) * m(2, 3, 0, 3) -
-                           m(0, 1, 1, 3) * m(2, 3, 0, 2) + m(0, 1, 2, 3) * m(2, 3, 0, 1);
-    return det.sign();
-  };
-  auto exact2 = [](const Vec3* p, const Vec3& d, int axis) {
-    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    ExactFloat r[3][3];
-    for (int i = 0; i < 3; ++i) {
-      const ExactFloat dd[3] = {ExactFloat(p[i].x) - ExactFloat(d.x), ExactFloat(p[i].y) - ExactFloat(d.y),
-                                ExactFloat(p[i].z) - ExactFloat(d.z)};
-      r[i][0] = dd[u], r[i][1] = dd[v], r[i][2] = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
-    }
-    const ExactFloat det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) -
-                           r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-                           r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-    return det.sign();
-  };
-  // Exactly cospherical points: (±3, ±4, 0), (0, ±3, ±4), (±4, 0, ±3) on the sphere of radius 5.
-  const Vec3 sphere[] = {{3, 4, 0}, {-3, 4, 0}, {0, 3, 4}, {0, -3, 4}, {4, 0, 3}, {4, 0, -3}, {-4, 0, 3}, {0, 5, 0}};
   int certified = 0, zeros = 0, trials = 0;
   for (int it = 0; it < 40000; ++it) {
     Vec3 p[5];
@@ -206,7 +213,7 @@ TEST(LiftedFilters, AgreeWithExact) {
       if (kind == 0) {
         p[i] = {U(rng), U(rng), U(rng)};
       } else {
-        p[i] = sphere[(it * 7 + i * 3) % 8];
+        p[i] = kCospherical[(it * 7 + i * 3) % 8];
         if (i == 4 && kind == 2) p[i].x = std::nextafter(p[i].x, pick(rng) < 2 ? 10.0 : -10.0);
         if (i == 4 && kind == 1 && pick(rng) == 0) p[i].y += std::ldexp(1.0, -45);
       }
@@ -214,14 +221,14 @@ TEST(LiftedFilters, AgreeWithExact) {
     }
     Sign f;
     ++trials;
-    const int ex3 = exact3(p, p[4]);
+    const int ex3 = exact_lifted_det3(p, p[4]);
     zeros += ex3 == 0;
     if (lifted_det3_filter(p[0], p[1], p[2], p[3], p[4], f)) {
       ++certified;
       ASSERT_EQ(static_cast<int>(f), ex3) << "it " << it;
     }
     const int axis = it % 3;
-    const int ex2 = exact2(p, p[3], axis);
+    const int ex2 = exact_lifted_det2(p, p[3], axis);
     if (lifted_det2_filter(p[0], p[1], p[2], p[3], axis, f)) ASSERT_EQ(static_cast<int>(f), ex2) << "it " << it;
   }
   std::printf("lifted_det3: %d of %d certified, %d exact zeros\n", certified, trials, zeros);
@@ -295,13 +302,12 @@ TEST(UncertainFilters, LiftedAgreeWithExactOfTheTruePoints) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(-1, 1), U01(0, 1);
   std::uniform_int_distribution<int> kind_of(0, 3), rexp(-60, -10);
-  const Vec3 sphere[] = {{3, 4, 0}, {-3, 4, 0}, {0, 3, 4}, {0, -3, 4}, {4, 0, 3}, {4, 0, -3}, {-4, 0, 3}, {0, 5, 0}};
   int certified3 = 0, certified2 = 0, zeros = 0;
   for (int it = 0; it < 40000; ++it) {
     const int kind = it % 3;
     Vec3 p[5];
     for (int i = 0; i < 5; ++i) {
-      p[i] = kind == 0 ? Vec3{U(rng), U(rng), U(rng)} : sphere[(it * 7 + i * 3) % 8];
+      p[i] = kind == 0 ? Vec3{U(rng), U(rng), U(rng)} : kCospherical[(it * 7 + i * 3) % 8];
       if (kind == 2 && i == 4) p[i].x = std::nextafter(p[i].x, 10.0);
     }
     double r[5];
@@ -311,37 +317,15 @@ TEST(UncertainFilters, LiftedAgreeWithExactOfTheTruePoints) {
       m[i] = {p[i].x + ri * U(rng), p[i].y + ri * U(rng), p[i].z + ri * U(rng)};
       r[i] = std::max({std::fabs(m[i].x - p[i].x), std::fabs(m[i].y - p[i].y), std::fabs(m[i].z - p[i].z)});
     }
-    Sign ex3, f;
-    ASSERT_TRUE(true);
-    {
-      ExactFloat q[4][4];
-      for (int i = 0; i < 4; ++i) {
-        const ExactFloat dx = ExactFloat(p[i].x) - ExactFloat(p[4].x), dy = ExactFloat(p[i].y) - ExactFloat(p[4].y),
-                         dz = ExactFloat(p[i].z) - ExactFloat(p[4].z);
-        q[i][0] = dx, q[i][1] = dy, q[i][2] = dz, q[i][3] = dx * dx + dy * dy + dz * dz;
-      }
-      auto mm = [&](int i, int j, int a, int b) { return q[i][a] * q[j][b] - q[i][b] * q[j][a]; };
-      const ExactFloat det = mm(0, 1, 0, 1) * mm(2, 3, 2, 3) - mm(0, 1, 0, 2) * mm(2, 3, 1, 3) +
-                             mm(0, 1, 0, 3) * mm(2, 3, 1, 2) + mm(0, 1, 1, 2) * mm(2, 3, 0, 3) -
-                             mm(0, 1, 1, 3) * mm(2, 3, 0, 2) + mm(0, 1, 2, 3) * mm(2, 3, 0, 1);
-      ex3 = det.sign() > 0 ? Sign::kPositive : det.sign() < 0 ? Sign::kNegative : Sign::kZero;
-    }
+    const Sign ex3 = static_cast<Sign>(exact_lifted_det3(p, p[4]));
+    Sign f;
     zeros += ex3 == Sign::kZero;
     if (lifted_det3_uncertain(m, r, m[4], r[4], f)) {
       ++certified3;
       ASSERT_EQ(f, ex3) << "it " << it;
     }
-    const int axis = it % 3, u = (axis + 1) % 3, v = (axis + 2) % 3;
-    ExactFloat q[3][3];
-    for (int i = 0; i < 3; ++i) {
-      const ExactFloat dd[3] = {ExactFloat(p[i].x) - ExactFloat(p[3].x), ExactFloat(p[i].y) - ExactFloat(p[3].y),
-                                ExactFloat(p[i].z) - ExactFloat(p[3].z)};
-      q[i][0] = dd[u], q[i][1] = dd[v], q[i][2] = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
-    }
-    const ExactFloat det2 = q[0][0] * (q[1][1] * q[2][2] - q[1][2] * q[2][1]) -
-                            q[0][1] * (q[1][0] * q[2][2] - q[1][2] * q[2][0]) +
-                            q[0][2] * (q[1][0] * q[2][1] - q[1][1] * q[2][0]);
-    const Sign ex2 = det2.sign() > 0 ? Sign::kPositive : det2.sign() < 0 ? Sign::kNegative : Sign::kZero;
+    const int axis = it % 3;
+    const Sign ex2 = static_cast<Sign>(exact_lifted_det2(p, p[3], axis));
     if (lifted_det2_uncertain(m, r, m[3], r[3], axis, f)) {
       ++certified2;
       ASSERT_EQ(f, ex2) << "it " << it;

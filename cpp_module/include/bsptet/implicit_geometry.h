@@ -136,6 +136,9 @@ class ImplicitGeometry {
   /// A double point m with every coordinate within r of vertex v's exact one (explicit: the point
   /// itself, r = 0; else the centre and width of box(v)); false when there is no box.
   bool approximate(Index v, Vec3* m, double* r);
+  /// approximate() for each of `ids`; false when one has no box.
+  template <std::size_t N>
+  bool approximate_all(const std::array<Index, N>& ids, std::array<Vec3, N>& m, std::array<double, N>& r);
   /// Intervals enclosing the vertex's Cartesian coordinates (a filter input tighter and cheaper
   /// than the homogeneous intervals); nullptr when W's interval contains zero or overflows.
   const std::array<Interval, 3>* box(Index v);
