@@ -134,6 +134,30 @@ def test_min_dihedral_is_raised_on_a_corpus_model():
     assert before > 0
 
 
+@pytest.mark.parametrize("name", ["pinion", "joint"])
+def test_optimization_rounds_do_not_grow_the_mesh_without_raising_its_angles(name):
+    """The sliver pass (split the longest interior edge of a tet below 15 degrees) stops once the
+    number of such tets rises from round to round. Without that rule, on inputs whose small
+    angles make every split there another sliver, eight rounds grew the mesh round after round
+    (pinion at h = diagonal / 20: 2,170 tets after one round, 14,293 after eight; adis16480
+    21,000 -> 157,000 in 143 s) while the worst angle stayed where one round left it."""
+    surface = read_surface(corpus_path(name))
+    mesh, _ = core.tetrahedralize(surface)
+    native = core._native()
+    results = {}
+    for rounds in (1, 8):
+        points, tets, st = native.refine(surface.points, surface.triangles, None, mesh.points,
+                                         mesh.tets, size=diag(surface) / 20, optimize_rounds=rounds)
+        refined = core.TetMesh(points, tets, surface.source)
+        report = core.check_mesh(surface, refined)
+        assert report["valid"], report["messages"]
+        assert set(st["seconds_by_pass"]) >= {"size", "collapse", "flip", "insert"}
+        results[rounds] = (len(tets), report["quality"]["min_dihedral_deg"])
+    (one, min_one), (eight, min_eight) = results[1], results[8]
+    assert eight <= 2 * one, results
+    assert min_eight >= 0.9 * min_one, results
+
+
 def test_refinement_is_deterministic():
     surface = read_surface(paper_path("dented_prism"))
     opts = {"size": diag(surface) / 10, "radius_edge": 2.0}
@@ -230,10 +254,11 @@ def test_cantilever_box_end_faces_are_exact():
                                                                              atol=1e-6)]
     assert set(np.unique(pts[near_end, 0]).tolist()) == {0.0, 8000.0}
     # Issue 4 asks for +-30% of Gmsh's 400. The quality stage's count depends on the order in
-    # which it visits the core's tets: 455 from the box-started core, 522 from the Delaunay seed
-    # (session 13; the same 6 tets in another order), 526 from the tets sorted. So the 30% is met
-    # by luck or missed by a few tets; the bound here is 35% until the count is robust (README,
-    # "What does not work yet").
+    # which it visits the core's tets: 476 from the box-started core, 519 from the Delaunay seed
+    # (session 15; the same 6 tets in another order), 452 to 511 (mean 493) over 16 random orders
+    # of the box-started core's tets. So the 30% (520) is met, but by one tet on the default
+    # path; the bound here is 35% until the count is robust (README, "What does not work yet").
+    # Gmsh itself (python3-gmsh 4.11, the OCC box) makes 362 tets at 500.
     assert 0.7 * 400 <= stats["tets"] <= 1.35 * 400
     lengths = edge_lengths(mesh)
     assert (lengths > 2.0 * 500.0 * (1 + 1e-9)).sum() <= stats["refine"]["long_edges_left"]

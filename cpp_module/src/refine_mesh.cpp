@@ -86,6 +86,7 @@ RefineMesh::RefineMesh(const SurfaceMesh& surface, const TetMesh& mesh, Projecti
   const Index np = mesh.num_points();
   xyz_.resize(static_cast<std::size_t>(np));
   for (Index i = 0; i < np; ++i) xyz_[static_cast<std::size_t>(i)] = mesh.point(i);
+  stamp_.assign(xyz_.size(), 0);
   support_.assign(static_cast<std::size_t>(np), PointSupport{});
   point_alive_.assign(static_cast<std::size_t>(np), 1);
   ball_.resize(static_cast<std::size_t>(np));
@@ -211,14 +212,28 @@ Index RefineMesh::add_point(const Vec3& p, const PointSupport& s) {
   support_.push_back(s);
   point_alive_.push_back(1);
   ball_.emplace_back();
+  stamp_.push_back(++clock_);
   return static_cast<Index>(xyz_.size() - 1);
+}
+
+void RefineMesh::touch(const std::array<Index, 4>& t) {
+  ++clock_;
+  for (Index v : t) stamp_[static_cast<std::size_t>(v)] = clock_;
+}
+
+std::uint64_t RefineMesh::tet_stamp(Index t) const {
+  std::uint64_t s = 0;
+  for (Index v : tet(t)) s = std::max(s, stamp_[static_cast<std::size_t>(v)]);
+  return s;
 }
 
 Index RefineMesh::add_tet(const std::array<Index, 4>& t) {
   const Index id = static_cast<Index>(tets_.size());
   tets_.push_back(t);
   tet_alive_.push_back(1);
+  neighbour_.insert(neighbour_.end(), 4, kUnknownNeighbour);
   quality_.push_back(quality_of(t));
+  touch(t);
   for (Index v : t) ball_[static_cast<std::size_t>(v)].push_back(id);
   ++alive_tets_;
   return id;
@@ -226,6 +241,7 @@ Index RefineMesh::add_tet(const std::array<Index, 4>& t) {
 
 void RefineMesh::kill_tet(Index t) {
   tet_alive_[static_cast<std::size_t>(t)] = 0;
+  touch(tets_[static_cast<std::size_t>(t)]);
   --alive_tets_;
 }
 
@@ -645,17 +661,21 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
 }
 
 Index RefineMesh::neighbour(Index t, int k) {
+  // Tets are never edited in place (only added and killed), so a cached neighbour is right while
+  // it lives, and a boundary face stays one for as long as t lives.
+  Index& cached = neighbour_[static_cast<std::size_t>(t) * 4 + static_cast<std::size_t>(k)];
+  if (cached == -1 || (cached >= 0 && tet_alive(cached))) return cached;
   const auto q = tet(t);
   const Index a = q[kOppositeFace[k][0]], b = q[kOppositeFace[k][1]], c = q[kOppositeFace[k][2]];
-  if (boundary_.count(face_key(a, b, c))) return -1;
+  if (boundary_.count(face_key(a, b, c))) return cached = -1;
   for (Index n : tets_around_point(a)) {
     if (n == t) continue;
     const auto& r = tet(n);
     const bool hb = r[0] == b || r[1] == b || r[2] == b || r[3] == b;
     const bool hc = r[0] == c || r[1] == c || r[2] == c || r[3] == c;
-    if (hb && hc) return n;
+    if (hb && hc) return cached = n;
   }
-  return -1;
+  return -1;  // not cached: a tet may be added across this face later
 }
 
 InsertOutcome RefineMesh::insert_point(
@@ -773,7 +793,10 @@ bool RefineMesh::relocate_point(Index v, const Vec3& p) {
     if (q[i] <= old_min + kImprovement) return false;
   }
   xyz_[static_cast<std::size_t>(v)] = p;
-  for (std::size_t i = 0; i < ball.size(); ++i) quality_[static_cast<std::size_t>(ball[i])] = q[i];
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    quality_[static_cast<std::size_t>(ball[i])] = q[i];
+    touch(tet(ball[i]));
+  }
   return true;
 }
 
@@ -792,6 +815,7 @@ bool RefineMesh::relocate_point_if(Index v, const Vec3& p,
   for (std::size_t i = 0; i < ball.size(); ++i) {
     const auto& c = moved[i];
     quality_[static_cast<std::size_t>(ball[i])] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
+    touch(tet(ball[i]));
   }
   return true;
 }

@@ -108,6 +108,9 @@ int main(int argc, char** argv) {
                 static_cast<long long>(st.relocations), static_cast<long long>(st.insertions),
                 static_cast<long long>(st.long_edges_left),
                 cst.seconds_total, st.seconds);
+    std::printf("  passes:");
+    for (const auto& [pass, seconds] : st.seconds_by_pass) std::printf("  %s %.3f", pass.c_str(), seconds);
+    std::printf("\n");
     for (const auto& msg : r.messages) std::printf("  %s\n", msg.c_str());
     if (!stem.empty()) write_tetgen(stem, m);
     return r.valid ? 0 : 1;

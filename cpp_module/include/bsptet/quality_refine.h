@@ -113,7 +113,9 @@ struct RefineStats {
   std::int64_t edge_removals = 0;        ///< n-to-2(n-2) flips, 4 <= n <= 7 (RefineMesh::remove_edge)
   std::int64_t insertions = 0;           ///< interior points inserted where they raise the worst angle
   std::int64_t size_passes = 0, optimize_rounds = 0;
-  std::int64_t long_edges_left = 0;      ///< edges still longer than split_ratio * target
+  /// Edges of the result longer than split_ratio * the asked target (size, size_by_tag, graded;
+  /// not raised around edges that could not be split).
+  std::int64_t long_edges_left = 0;
   std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split
   std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
@@ -121,6 +123,9 @@ struct RefineStats {
                                             ///< curved elements stay valid (quality_refine.cpp)
   std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element was still invalid
   double seconds = 0;
+  /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,
+  /// separate_face_tags, curving (the passes that ran).
+  std::map<std::string, double> seconds_by_pass;
 };
 
 /// Refines and optimizes `mesh`, a valid linear tet mesh of `surface`. Throws InputError for bad

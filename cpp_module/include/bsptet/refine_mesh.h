@@ -111,6 +111,12 @@ class RefineMesh {
   /// Min dihedral angle of a live tet, degrees (cached).
   double tet_quality(Index t) const { return quality_[static_cast<std::size_t>(t)]; }
   Index num_alive_tets() const { return alive_tets_; }
+  /// Change stamps: clock() grows with every change (a tet added or removed, a point moved); a
+  /// point's stamp is the clock of the last change to a tet containing it (added, removed or
+  /// reshaped), tet_stamp(t) the largest of its corners'. When tet_stamp(t) has not grown since
+  /// an operation on t failed, the tets around t's corners are the same and in the same place.
+  std::uint64_t clock() const { return clock_; }
+  std::uint64_t tet_stamp(Index t) const;
   /// Live tets incident to point v, in increasing id order (valid until the next change).
   const std::vector<Index>& tets_around_point(Index v);
   /// Live tets containing both u and v, in increasing id order (empty when (u, v) is no edge).
@@ -205,6 +211,7 @@ class RefineMesh {
 
   Index add_tet(const std::array<Index, 4>& t);
   void kill_tet(Index t);
+  void touch(const std::array<Index, 4>& t);  ///< a change to tet t: its corners get a new stamp
   Index add_point(const Vec3& p, const PointSupport& s);
   bool positive(const std::array<Index, 4>& t) const;
   bool positive_with(const std::array<Index, 4>& t, Index moved, const Vec3& p) const;
@@ -225,6 +232,12 @@ class RefineMesh {
   std::vector<char> tet_alive_;
   std::vector<double> quality_;
   std::vector<std::vector<Index>> ball_;  ///< point -> tets (dead ids removed lazily)
+  /// neighbour(t, k) cached at 4 t + k: kUnknownNeighbour, -1 (boundary) or a tet, valid while
+  /// it is alive.
+  static constexpr Index kUnknownNeighbour = -2;
+  std::vector<Index> neighbour_;
+  std::vector<std::uint64_t> stamp_;  ///< per point, see clock()
+  std::uint64_t clock_ = 0;
   std::unordered_map<FaceKey, Index, FaceKeyHash> boundary_;  ///< sorted face -> parent triangle
   Index alive_tets_ = 0;
   Index first_added_point_ = 0;
