@@ -299,6 +299,10 @@ def _merge_stats(all_stats):
                 for key, value in v.items():
                     if isinstance(value, (int, float)) and not isinstance(value, bool):
                         agg[key] = agg.get(key, 0) + value
+                    elif key == "seconds_by_pass":
+                        passes = agg.setdefault(key, {})
+                        for name, seconds in value.items():
+                            passes[name] = passes.get(name, 0) + seconds
                 continue
             if k in ("seconds_by_stage", "steiner_seconds_by_phase", "steiner_removed_by_phase"):
                 agg = out.setdefault(k, {})

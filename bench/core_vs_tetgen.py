@@ -4,7 +4,9 @@
     bench/core_vs_tetgen.py [MODELS_OR_FOLDERS ...] [--timeout S] [--markdown FILE]
 
 The comparison of ``fembsptet benchmark`` (FemBspTet/compare/benchmark.py) restricted to our
-mesher and ``tetgen -pY`` (default models: tests/data/paper and tests/data/corpus): per model
+mesher (twice: the Python worker users run, and the C++ core's own program ``bsptet_mesh
+--no-check``, timed like TetGen's program without the worker's start-up and check; both meshes
+are checked by the benchmark) and ``tetgen -pY`` (default models: tests/data/paper and tests/data/corpus): per model
 nodes, tets, Steiner points, dihedral angles, seconds and peak memory of each mesher's own
 process, whether our exact checker accepts each mesh, then the ratios against TetGen and their
 medians. ``fembsptet benchmark`` adds Gmsh.
@@ -18,7 +20,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from FemBspTet.compare.benchmark import model_paths, report_markdown, run_benchmark  # noqa: E402
-from FemBspTet.compare.comparison import OURS, TETGEN_PY  # noqa: E402
+from FemBspTet.compare.comparison import OURS, OURS_NATIVE, TETGEN_PY  # noqa: E402
 
 
 def main(argv=None):
@@ -29,7 +31,8 @@ def main(argv=None):
     args = ap.parse_args(argv)
     paths = model_paths(args.models or [os.path.join(ROOT, "tests/data/paper"),
                                         os.path.join(ROOT, "tests/data/corpus")])
-    entries = run_benchmark(paths, timeout=args.timeout, meshers=(OURS, TETGEN_PY), log=print)
+    entries = run_benchmark(paths, timeout=args.timeout, meshers=(OURS, OURS_NATIVE, TETGEN_PY),
+                            log=print)
     text = report_markdown(entries, "bench/core_vs_tetgen.py " + " ".join(sys.argv[1:]))
     print(text[text.index("## Ratios"):])
     if args.markdown:

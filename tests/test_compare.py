@@ -154,3 +154,22 @@ def test_benchmark_report(cli, tmp_path):
     median_tets = float(np.median([a["tets"] / b["tets"] for a, b in zip(ours, tg)]))
     line = next(x for x in text.splitlines() if x.startswith("| FemBspTet / tetgen -pY | 2 |"))
     assert line.split("|")[4].strip() == f"{median_tets:.3g}"
+
+
+@pytest.mark.parametrize("name", ["schoenhardt", "dented_prism"])
+def test_native_core_row_meshes_like_the_worker_and_is_checked_from_its_files(tmp_path, name):
+    """``ours-native`` (bsptet_mesh --no-check, bench/core_vs_tetgen.py): the same mesh as our
+    worker's (the same core), read back from the .node/.ele it wrote and checked exactly here;
+    with a size it is left out (the core alone makes no quality mesh)."""
+    from FemBspTet.compare.comparison import OURS, OURS_NATIVE, compare, core_tool_path
+
+    assert core_tool_path() is not None  # scripts/setup.sh builds it
+    surface = read_surface(paper_path(name))
+    result = compare(surface, meshers=(OURS, OURS_NATIVE), workdir=str(tmp_path / "w"))
+    ours, native = result.row(OURS), result.row(OURS_NATIVE)
+    assert native.status == "ok" and native.valid, native.message
+    assert (native.nodes, native.tets) == (ours.nodes, ours.tets)
+    assert native.steiner_interior == ours.steiner_interior
+    mesh = read_tetgen(native.mesh_files[0][:-len(".node")])
+    assert len(mesh.tets) == native.tets
+    assert [r.mesher for r in compare(surface, size=1.0, meshers=(OURS_NATIVE,)).rows] == []

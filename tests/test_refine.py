@@ -262,6 +262,7 @@ def test_cantilever_box_end_faces_are_exact():
     assert 0.7 * 400 <= stats["tets"] <= 1.35 * 400
     lengths = edge_lengths(mesh)
     assert (lengths > 2.0 * 500.0 * (1 + 1e-9)).sum() <= stats["refine"]["long_edges_left"]
+    assert set(stats["refine"]["seconds_by_pass"]) >= {"size", "collapse", "flip", "smooth"}
 
 
 def test_size_by_tag_refines_near_one_face():

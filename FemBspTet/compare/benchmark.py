@@ -18,7 +18,8 @@ import subprocess
 
 from ..cli import CAD_EXTENSIONS, SURFACE_EXTENSIONS
 from ..errors import BspTetError
-from .comparison import COLUMNS, GMSH, OURS, TETGEN_PY, compare, draw_histograms, row_label
+from .comparison import (COLUMNS, GMSH, OURS, OURS_NATIVE, TETGEN_PY, compare, draw_histograms,
+                         row_label)
 from .process import DEFAULT_TIMEOUT
 
 #: Extensions the benchmark takes from a folder (the inputs of ``fembsptet mesh``).
@@ -227,7 +228,7 @@ def report_markdown(entries, command="", png_name=None, env=None):
     for e in entries:
         if e.comparison is None:
             continue
-        for mesher in (OURS, GMSH):
+        for mesher in (OURS, OURS_NATIVE, GMSH):
             rs = ratios(e.comparison, mesher)
             if rs is None:
                 continue
@@ -239,7 +240,7 @@ def report_markdown(entries, command="", png_name=None, env=None):
               "|---|---|" + "---|" * len(names)]
     for mesher, rows in collected.items():
         meds = [statistics.median(r[n] for r in rows if r[n] == r[n]) for n in names]
-        label = "FemBspTet" if mesher == OURS else "gmsh -3"
+        label = {OURS: "FemBspTet", OURS_NATIVE: "bsptet_mesh (C++ core)"}.get(mesher, "gmsh -3")
         lines.append(f"| {label} / tetgen -pY | {len(rows)} | "
                      + " | ".join(f"{m:.3g}" for m in meds) + " |")
     lines += ["", _outcome_summary(entries)]

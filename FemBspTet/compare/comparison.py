@@ -48,7 +48,12 @@ from ..mesh_types import Surface, TetMesh
 from .process import DEFAULT_TIMEOUT, run_measured
 
 OURS, TETGEN_PY, TETGEN_PQ, GMSH = "ours", "tetgen-pY", "tetgen-pq", "gmsh"
-#: Every mesher of the comparison, in table order.
+#: Our core alone as a native program (``build/cpp_module/bsptet_mesh --no-check``), for timing
+#: the core beside TetGen's own program without our Python worker's start-up (about 0.15 s) and
+#: in-process check; its mesh is read back and checked here like every other. Opt-in: not in
+#: MESHERS, and only without a size (the core makes no quality mesh).
+OURS_NATIVE = "ours-native"
+#: Every mesher of the default comparison, in table order.
 MESHERS = (OURS, TETGEN_PY, TETGEN_PQ, GMSH)
 
 #: Checks applied, by how the mesh's boundary relates to the input.
@@ -240,6 +245,42 @@ def _run_ours(surfaces, size, timeout, workdir, python, options=None):
     return [read_tet_mesh(f) for f in files], run.seconds, run.peak_rss_mb, files
 
 
+def core_tool_path():
+    """``bsptet_mesh``, the core's command-line program built by scripts/setup.sh, or None."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    path = os.environ.get("FEMBSPTET_CORE_TOOL") or os.path.join(root, "build", "cpp_module",
+                                                                 "bsptet_mesh")
+    return path if os.path.isfile(path) and os.access(path, os.X_OK) else None
+
+
+def _run_ours_native(surfaces, timeout, workdir):
+    from ..surface_io import write_surface
+    from ..volume_io import read_tetgen
+
+    exe = core_tool_path()
+    if exe is None:
+        raise MesherFailed("skipped", "build/cpp_module/bsptet_mesh is not built (scripts/setup.sh)")
+    meshes, seconds, rss, files = [], 0.0, 0.0, []
+    for k, s in enumerate(surfaces):
+        src = os.path.join(workdir, f"solid{k}.native.off")
+        stem = os.path.join(workdir, f"solid{k}.native")
+        write_surface(src, s)
+        remaining = None if timeout is None else max(timeout - seconds, 0.01)
+        run = run_measured([exe, src, "--no-check", "--write", stem], timeout=remaining,
+                           cwd=workdir)
+        if run.timed_out:
+            raise MesherFailed("timeout", f"timeout after {timeout:g} s")
+        if run.returncode != 0:
+            lines = [ln for ln in run.output.strip().splitlines() if ln.strip()]
+            msg = lines[0] if lines else f"exit {run.returncode}"
+            raise MesherFailed("failed", msg.split(": ", 1)[-1][:300])
+        meshes.append(read_tetgen(stem))
+        seconds += run.seconds
+        rss = max(rss, run.peak_rss_mb)
+        files += [stem + ".node", stem + ".ele"]
+    return meshes, seconds, rss, files
+
+
 def _run_per_solid(run_one, surfaces, timeout):
     """Runs ``run_one(surface, remaining_timeout, name)`` per solid; sums seconds, max memory."""
     meshes, seconds, rss, files = [], 0.0, 0.0, []
@@ -296,6 +337,8 @@ def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, our
     workdir = workdir or tempfile.mkdtemp(prefix="fembsptet_compare_")
     if mesher == OURS:
         command = "fembsptet" + (f" --size {size:g}" if size is not None else "")
+    elif mesher == OURS_NATIVE:
+        command = "bsptet_mesh --no-check"
     elif mesher == TETGEN_PY:
         command = "tetgen -pY"
     elif mesher == TETGEN_PQ:
@@ -309,6 +352,9 @@ def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, our
         if mesher == OURS:
             meshes, row.seconds, row.peak_rss_mb, files = _run_ours(
                 surfaces, size, timeout, workdir, python or DEFAULT_PYTHON, ours_options)
+        elif mesher == OURS_NATIVE:
+            meshes, row.seconds, row.peak_rss_mb, files = _run_ours_native(surfaces, timeout,
+                                                                           workdir)
         elif mesher in (TETGEN_PY, TETGEN_PQ):
             meshes, row.seconds, row.peak_rss_mb, files = _run_tetgen(
                 surfaces, command.split(" -")[1], timeout, workdir)
@@ -358,7 +404,7 @@ def compare(surfaces, size=None, timeout=DEFAULT_TIMEOUT, workdir=None, meshers=
         os.makedirs(workdir, exist_ok=True)
     rows = []
     for mesher in meshers:
-        if mesher == TETGEN_PQ and size is None:
+        if (mesher == TETGEN_PQ and size is None) or (mesher == OURS_NATIVE and size is not None):
             continue
         rows.append(_mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python,
                                 ours_options))
@@ -374,7 +420,8 @@ def compare(surfaces, size=None, timeout=DEFAULT_TIMEOUT, workdir=None, meshers=
 # ------------------------------------------------------------------------------------------
 
 def row_label(row):
-    return {OURS: "FemBspTet"}.get(row.mesher, row.command.split(" (")[0])
+    return {OURS: "FemBspTet", OURS_NATIVE: "bsptet_mesh (C++ core)"}.get(
+        row.mesher, row.command.split(" (")[0])
 
 
 def row_dict(row: Row) -> dict:
@@ -442,7 +489,7 @@ def write_json(path, result: Comparison):
 
 
 #: Colour of each mesher in the plots.
-COLORS = {OURS: "tab:blue", TETGEN_PY: "tab:red", TETGEN_PQ: "tab:orange", GMSH: "tab:green"}
+COLORS = {OURS: "tab:blue", OURS_NATIVE: "tab:purple", TETGEN_PY: "tab:red", TETGEN_PQ: "tab:orange", GMSH: "tab:green"}
 
 
 def draw_histograms(ax, rows, legend=True, bin_width=5):

@@ -13,12 +13,15 @@
 // --progress: print each stage and its percentage to stderr as it goes.
 // --cone-cells: fill the cells by cones (the filler before the per-cell Delaunay), for comparison.
 // --seed: what the BSP starts from (MeshOptions::seed; default auto).
+// --no-check: skip the exact check of the output (timing the core alone, as a benchmark beside
+//   TetGen does; the benchmark then checks the written mesh itself). Prints UNCHECKED, exit 0.
 //
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
 // shells facing the wrong way); --reorient flips triangles as that check allows.
 //
 // Exit: 0 valid mesh, 1 meshing error or invalid mesh, 2 bad input.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -35,13 +38,14 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--seed auto|delaunay|box] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
-                 "[--progress] [--write STEM]\n",
+                 "[--progress] [--no-check] [--write STEM]\n",
                  argv[0]);
     return 2;
   }
   MeshOptions o;
   SurfaceCheckOptions check;
   std::string stem;
+  bool no_check = false;
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
@@ -60,6 +64,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--bsp-shift") && i + 1 < argc) o.bsp_candidate_shift = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--steiner-effort") && i + 1 < argc) o.steiner_effort = std::strtoll(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--reorient")) check.reorient = true;
+    else if (!std::strcmp(argv[i], "--no-check")) no_check = true;
     else if (!std::strcmp(argv[i], "--progress"))
       o.progress = [last = std::string(), last_pct = -1](const std::string& stage, double f) mutable {
         const int pct = static_cast<int>(f * 100);
@@ -78,11 +83,17 @@ int main(int argc, char** argv) {
     s.tri = check_surface(s, check).tri;
     MeshStats st;
     const TetMesh m = tetrahedralize(s, o, &st);
-    const MeshCheckReport r = check_mesh(s, m);
+    MeshCheckReport r;
+    if (no_check) {
+      r.valid = true;
+      r.quality.min_dihedral_deg = std::nan("");
+    } else {
+      r = check_mesh(s, m);
+    }
     std::printf("%s: %s tets %d points %d steiner %lld (before removal %lld, on surface %lld) collapsed %lld "
                 "relocated %lld pushed %lld cells %lld inside %lld pulled %lld apex %lld delaunay %lld (recovered %lld) fallback %lld bsp_points %lld seconds %.3f "
                 "min_dihedral %.2f%s%s\n",
-                argv[1], r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
+                argv[1], no_check ? "UNCHECKED" : r.valid ? "VALID" : "INVALID", m.num_tets(), m.num_points(),
                 static_cast<long long>(st.steiner_points), static_cast<long long>(st.steiner_before_removal),
                 static_cast<long long>(st.boundary_steiner_before_removal), static_cast<long long>(st.collapsed),
                 static_cast<long long>(st.relocated), static_cast<long long>(st.pushed), static_cast<long long>(st.convex_cells),
