@@ -33,6 +33,8 @@
 #include "bsptet/bsp_complex.h"
 #include "bsptet/cell_delaunay.h"
 #include "bsptet/errors.h"
+#include "bsptet/exact_float.h"
+#include "bsptet/interval.h"
 #include "bsptet/predicates.h"
 
 namespace bsptet {
@@ -64,9 +66,56 @@ void dot_bounds(const Vec3& p, const Vec3& n, double& lo, double& hi) {
   hi = d + err;
 }
 
+// sign det(a1 - a0, b1 - b0, x - y), exactly: intervals, then ExactFloat. The projection of x - y
+// on the direction (a1 - a0) x (b1 - b0) of an edge pair.
+int edge_pair_det(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, const Vec3& x, const Vec3& y) {
+  {
+    const Interval ax = Interval(a1.x) - Interval(a0.x), ay = Interval(a1.y) - Interval(a0.y),
+                   az = Interval(a1.z) - Interval(a0.z);
+    const Interval bx = Interval(b1.x) - Interval(b0.x), by = Interval(b1.y) - Interval(b0.y),
+                   bz = Interval(b1.z) - Interval(b0.z);
+    const Interval cx = Interval(x.x) - Interval(y.x), cy = Interval(x.y) - Interval(y.y),
+                   cz = Interval(x.z) - Interval(y.z);
+    const Interval d = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+    const int s = d.certain_sign();
+    if (s != 0) return s;
+  }
+  const ExactFloat ax = ExactFloat(a1.x) - ExactFloat(a0.x), ay = ExactFloat(a1.y) - ExactFloat(a0.y),
+                   az = ExactFloat(a1.z) - ExactFloat(a0.z);
+  const ExactFloat bx = ExactFloat(b1.x) - ExactFloat(b0.x), by = ExactFloat(b1.y) - ExactFloat(b0.y),
+                   bz = ExactFloat(b1.z) - ExactFloat(b0.z);
+  const ExactFloat cx = ExactFloat(x.x) - ExactFloat(y.x), cy = ExactFloat(x.y) - ExactFloat(y.y),
+                   cz = ExactFloat(x.z) - ExactFloat(y.z);
+  return (ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)).sign();
+}
+
+// True when the edge pair (tet edge e0 e1, triangle edge f0 f1) gives a plane that weakly
+// separates the tet (p) from the triangle (q, with f0 = q[k], f1 = q[(k + 1) % 3], g = the third
+// corner): every tet corner on one closed side, every triangle corner on the other. Exact. The
+// direction n = (e1 - e0) x (f1 - f0) must not vanish (parallel edges: no plane).
+bool edge_pair_separates(const std::array<Vec3, 4>& p, const Vec3& e0, const Vec3& e1, const Vec3& f0,
+                         const Vec3& f1, const Vec3& g) {
+  // n = 0 exactly iff n . x vanishes for three independent x: the axes.
+  static const Vec3 kO{0, 0, 0}, kAxis[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  bool parallel = true;
+  for (const Vec3& axis : kAxis) parallel = parallel && edge_pair_det(e0, e1, f0, f1, axis, kO) == 0;
+  if (parallel) return false;
+  // n . f0 = n . f1; the triangle's lowest and highest corners along n.
+  const int sg = edge_pair_det(e0, e1, f0, f1, g, f0);
+  const Vec3& low = sg >= 0 ? f0 : g;
+  const Vec3& high = sg <= 0 ? f0 : g;
+  bool below = true, above = true;  // the tet below the triangle's lowest / above its highest corner
+  for (const Vec3& x : p) {
+    if (below && edge_pair_det(e0, e1, f0, f1, x, low) > 0) below = false;
+    if (above && edge_pair_det(e0, e1, f0, f1, x, high) < 0) above = false;
+    if (!below && !above) return false;
+  }
+  return true;
+}
+
 // How a tet (positive, corners p) and a triangle (q) meet: 0 when the closed sets are proved
-// disjoint, 1 when their interiors are proved disjoint (they may touch), 2 otherwise (the triangle
-// may cross the tet's interior). Separating axes: the tet's face planes and the triangle's plane
+// disjoint, 1 when the triangle is proved to miss the tet's interior (they may touch), 2 when it
+// crosses the interior (exact: see the last step). Separating axes: the tet's face planes and the triangle's plane
 // (exact orient3d), then the 18 edge-pair directions (rounded, with certified bounds on the
 // projections: any direction proves a separation its projections show). `share_vertex`: the two
 // have a common corner (so they touch).
@@ -140,7 +189,17 @@ int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 
       if (thi <= qlo || qhi <= tlo) weak = true;
     }
   }
-  return weak ? 1 : 2;
+  if (weak) return 1;
+  // The rounded projections cannot show a separation in which the two touch (a shared corner
+  // projects to the same value on both sides): decide the edge pairs exactly. With the face
+  // planes above they are every facet direction of the Minkowski difference tet - triangle, so
+  // the triangle misses the tet's interior iff one of them separates weakly. Nearly coplanar
+  // input triangles (a rotated CAD tessellation) made many seed tets that only touch a triangle
+  // along an edge look crossed, and the BSP cut each of them by the triangle's plane.
+  for (const auto& e : kEdge)
+    for (int k = 0; k < 3; ++k)
+      if (edge_pair_separates(p, p[e[0]], p[e[1]], q[k], q[(k + 1) % 3], q[(k + 2) % 3])) return 1;
+  return 2;
 }
 
 // The seed need not be Delaunay: any tetrahedralization of the points gives convex cells. Input
@@ -690,8 +749,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // 3. Conflict lists and coplanar lists. An input triangle that is a face of the seed crosses
   // no tet (faces of a tetrahedralization never meet a tet's interior) and overlaps no other
   // face: it goes on that face's coplanar list, nothing more. Any other triangle walks over the
-  // tets it meets (the separating-axis test cannot always tell a tet that only shares a corner
-  // with the triangle from one it crosses, and counts it as crossed: a conservative superset).
+  // tets it meets; those whose interior it crosses (tet_triangle_relation, exact) get it on their
+  // conflict list.
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<Index> queue;
@@ -770,6 +829,11 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
   }
   lap("seed_lines");
+}
+
+int seed_tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 4>& pid,
+                               const std::array<Vec3, 3>& q, const std::array<Index, 3>& qid) {
+  return tet_triangle_relation(p, pid, q, qid);
 }
 
 }  // namespace bsptet
