@@ -80,6 +80,7 @@ class Refiner {
   void run() {
     timed("targets", [&] { compute_targets(); return 0; });
     timed("size", [&] { size_phase(); return 0; });
+    tets_after_size_ = m_.num_alive_tets();
     optimize_phase(o_.optimize_rounds);
     // Collapses and smoothing may have left some edges long again: one more short round, whose
     // splits never make a tet worse than the worst of the tets they replace (after the
@@ -964,7 +965,12 @@ class Refiner {
       changes += timed("insert", [&] { return insert_pass(std::min(goal, 15.0)); });
       if (round + 1 < rounds && std::isfinite(o_.size)) {
         const std::size_t slivers = tets_below(std::min(goal, 15.0)).size();
-        if (slivers < slivers_before) changes += timed("sliver", [&] { return sliver_pass(std::min(goal, 15.0)); });
+        // Curved tet10 elements need room over the curved faces, which these splits give:
+        // there the pass goes on while the mesh stays within three times its size after the
+        // first size phase (featuretype.STEP meshes at tet10 with it, not without).
+        const bool curved = o_.order == 2 && static_cast<bool>(o_.projection);
+        if (slivers < slivers_before || (curved && m_.num_alive_tets() <= 3 * tets_after_size_))
+          changes += timed("sliver", [&] { return sliver_pass(std::min(goal, 15.0)); });
         slivers_before = slivers < slivers_before ? slivers : 0;
       }
       ++st_.optimize_rounds;
@@ -994,6 +1000,7 @@ class Refiner {
   double floor_ = 0;
   Index budget_ = 0;
   std::vector<std::uint64_t> flip_failed_at_, insert_failed_at_;  ///< see failed_before
+  Index tets_after_size_ = 0;  ///< live tets after the first size phase (optimize_phase)
 };
 
 }  // namespace

@@ -23,7 +23,12 @@
 //     new interior point where it raises the worst angle of its Bowyer-Watson cavity (candidates:
 //     the apex of a regular tet over each of their faces, circumcentre, centroid; this lifts the
 //     flat tets whose four corners lie on the surface, which no flip can mend). Without a size,
-//     the longest-edge splits of slivers are skipped (they only grew the mesh there). Rounds stop when nothing changes
+//     the longest-edge splits of slivers are skipped (they only grew the mesh there). With one,
+//     they stop at the first round whose tets below 15 degrees are not fewer than the round
+//     before's (except, for curved tet10 through a projection hook, while the mesh stays within
+//     three times its size after step 1). A tet on which every flip (or every insertion
+//     candidate) failed is not tried again until a tet around one of its corners changes
+//     (RefineMesh change stamps). Rounds stop when nothing changes
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
 //  2b. separate_face_tags (optional): see the option;
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
