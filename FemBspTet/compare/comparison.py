@@ -254,31 +254,32 @@ def core_tool_path():
 
 
 def _run_ours_native(surfaces, timeout, workdir):
+    from types import SimpleNamespace
+
     from ..surface_io import write_surface
     from ..volume_io import read_tetgen
 
     exe = core_tool_path()
     if exe is None:
         raise MesherFailed("skipped", "build/cpp_module/bsptet_mesh is not built (scripts/setup.sh)")
-    meshes, seconds, rss, files = [], 0.0, 0.0, []
-    for k, s in enumerate(surfaces):
-        src = os.path.join(workdir, f"solid{k}.native.off")
-        stem = os.path.join(workdir, f"solid{k}.native")
+
+    def one(s, t, name):
+        src, stem = os.path.join(workdir, f"{name}.native.off"), os.path.join(workdir, f"{name}.native")
         write_surface(src, s)
-        remaining = None if timeout is None else max(timeout - seconds, 0.01)
-        run = run_measured([exe, src, "--no-check", "--write", stem], timeout=remaining,
-                           cwd=workdir)
+        run = run_measured([exe, src, "--no-check", "--write", stem], timeout=t, cwd=workdir)
         if run.timed_out:
-            raise MesherFailed("timeout", f"timeout after {timeout:g} s")
+            raise InternalError(f"bsptet_mesh timed out after {t:g} s")
         if run.returncode != 0:
             lines = [ln for ln in run.output.strip().splitlines() if ln.strip()]
-            msg = lines[0] if lines else f"exit {run.returncode}"
-            raise MesherFailed("failed", msg.split(": ", 1)[-1][:300])
-        meshes.append(read_tetgen(stem))
-        seconds += run.seconds
-        rss = max(rss, run.peak_rss_mb)
-        files += [stem + ".node", stem + ".ele"]
-    return meshes, seconds, rss, files
+            msg = (lines[0] if lines else f"exit {run.returncode}").split(": ", 1)[-1]
+            for prefix in ("INPUT ERROR ", "ERROR "):
+                msg = msg[len(prefix):] if msg.startswith(prefix) else msg
+            raise InternalError(msg)
+        return SimpleNamespace(mesh=read_tetgen(stem), seconds=run.seconds,
+                               peak_rss_mb=run.peak_rss_mb, mesh_path=stem)
+
+    meshes, seconds, rss, stems = _run_per_solid(one, surfaces, timeout)
+    return meshes, seconds, rss, [st + ext for st in stems for ext in (".node", ".ele")]
 
 
 def _run_per_solid(run_one, surfaces, timeout):

@@ -66,28 +66,53 @@ void dot_bounds(const Vec3& p, const Vec3& n, double& lo, double& hi) {
   hi = d + err;
 }
 
-// sign det(a1 - a0, b1 - b0, x - y), exactly: intervals, then ExactFloat. The projection of x - y
-// on the direction (a1 - a0) x (b1 - b0) of an edge pair.
-int edge_pair_det(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, const Vec3& x, const Vec3& y) {
-  {
-    const Interval ax = Interval(a1.x) - Interval(a0.x), ay = Interval(a1.y) - Interval(a0.y),
-                   az = Interval(a1.z) - Interval(a0.z);
-    const Interval bx = Interval(b1.x) - Interval(b0.x), by = Interval(b1.y) - Interval(b0.y),
-                   bz = Interval(b1.z) - Interval(b0.z);
-    const Interval cx = Interval(x.x) - Interval(y.x), cy = Interval(x.y) - Interval(y.y),
-                   cz = Interval(x.z) - Interval(y.z);
-    const Interval d = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
-    const int s = d.certain_sign();
-    if (s != 0) return s;
-  }
-  const ExactFloat ax = ExactFloat(a1.x) - ExactFloat(a0.x), ay = ExactFloat(a1.y) - ExactFloat(a0.y),
-                   az = ExactFloat(a1.z) - ExactFloat(a0.z);
-  const ExactFloat bx = ExactFloat(b1.x) - ExactFloat(b0.x), by = ExactFloat(b1.y) - ExactFloat(b0.y),
-                   bz = ExactFloat(b1.z) - ExactFloat(b0.z);
-  const ExactFloat cx = ExactFloat(x.x) - ExactFloat(y.x), cy = ExactFloat(x.y) - ExactFloat(y.y),
-                   cz = ExactFloat(x.z) - ExactFloat(y.z);
-  return (ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)).sign();
+template <class T>
+std::array<T, 3> difference(const Vec3& a, const Vec3& b) {
+  return {T(a.x) - T(b.x), T(a.y) - T(b.y), T(a.z) - T(b.z)};
 }
+template <class T>
+std::array<T, 3> cross(const std::array<T, 3>& u, const std::array<T, 3>& v) {
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+template <class T>
+T dot(const std::array<T, 3>& u, const std::array<T, 3>& v) {
+  return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+// The direction n = (e1 - e0) x (f1 - f0) of an edge pair, for exact signs of n . (x - y):
+// intervals first, the exact cross product only when they cannot tell.
+class EdgePairDirection {
+ public:
+  EdgePairDirection(const Vec3& e0, const Vec3& e1, const Vec3& f0, const Vec3& f1)
+      : e0_(e0), e1_(e1), f0_(f0), f1_(f1),
+        approx_(cross(difference<Interval>(e1, e0), difference<Interval>(f1, f0))) {}
+  /// n = 0 (parallel edges), exactly.
+  bool vanishes() {
+    for (const Interval& c : approx_)
+      if (c.certain_sign() != 0) return false;
+    for (const ExactFloat& c : exact())
+      if (c.sign() != 0) return false;
+    return true;
+  }
+  /// sign of n . (x - y), exactly.
+  int sign(const Vec3& x, const Vec3& y) {
+    const int s = dot(approx_, difference<Interval>(x, y)).certain_sign();
+    return s != 0 ? s : dot(exact(), difference<ExactFloat>(x, y)).sign();
+  }
+
+ private:
+  const std::array<ExactFloat, 3>& exact() {
+    if (!have_exact_) {
+      exact_ = cross(difference<ExactFloat>(e1_, e0_), difference<ExactFloat>(f1_, f0_));
+      have_exact_ = true;
+    }
+    return exact_;
+  }
+  Vec3 e0_, e1_, f0_, f1_;
+  std::array<Interval, 3> approx_;
+  std::array<ExactFloat, 3> exact_;
+  bool have_exact_ = false;
+};
 
 // True when the edge pair (tet edge e0 e1, triangle edge f0 f1) gives a plane that weakly
 // separates the tet (p) from the triangle (q, with f0 = q[k], f1 = q[(k + 1) % 3], g = the third
@@ -95,19 +120,16 @@ int edge_pair_det(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1
 // direction n = (e1 - e0) x (f1 - f0) must not vanish (parallel edges: no plane).
 bool edge_pair_separates(const std::array<Vec3, 4>& p, const Vec3& e0, const Vec3& e1, const Vec3& f0,
                          const Vec3& f1, const Vec3& g) {
-  // n = 0 exactly iff n . x vanishes for three independent x: the axes.
-  static const Vec3 kO{0, 0, 0}, kAxis[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  bool parallel = true;
-  for (const Vec3& axis : kAxis) parallel = parallel && edge_pair_det(e0, e1, f0, f1, axis, kO) == 0;
-  if (parallel) return false;
+  EdgePairDirection n(e0, e1, f0, f1);
+  if (n.vanishes()) return false;
   // n . f0 = n . f1; the triangle's lowest and highest corners along n.
-  const int sg = edge_pair_det(e0, e1, f0, f1, g, f0);
+  const int sg = n.sign(g, f0);
   const Vec3& low = sg >= 0 ? f0 : g;
   const Vec3& high = sg <= 0 ? f0 : g;
   bool below = true, above = true;  // the tet below the triangle's lowest / above its highest corner
   for (const Vec3& x : p) {
-    if (below && edge_pair_det(e0, e1, f0, f1, x, low) > 0) below = false;
-    if (above && edge_pair_det(e0, e1, f0, f1, x, high) < 0) above = false;
+    if (below && n.sign(x, low) > 0) below = false;
+    if (above && n.sign(x, high) < 0) above = false;
     if (!below && !above) return false;
   }
   return true;

@@ -633,6 +633,12 @@ class Refiner {
     return out;
   }
 
+  std::size_t count_below(double q) const {
+    std::size_t n = 0;
+    for (Index t = 0; t < m_.num_tet_slots(); ++t) n += m_.tet_alive(t) && m_.tet_quality(t) < q;
+    return n;
+  }
+
   std::int64_t flip_pass(double below) {
     std::int64_t flips = 0;
     std::vector<char> tried(static_cast<std::size_t>(m_.num_tet_slots()), 0);
@@ -820,13 +826,13 @@ class Refiner {
   // face would want: this is what lifts flat tets whose four corners lie on the surface, which no
   // flip or interior split can mend), then the circumcentre and the centroid.
   std::int64_t insert_pass(double below) {
-    std::int64_t n = 0, skipped = 0, tried = 0; auto bad = tets_below(below);
-    for (Index t : bad) {
-      if (!m_.tet_alive(t)) continue;
-      if (failed_before(insert_failed_at_, t)) { ++skipped; continue; }
-      ++tried;
-      if (insert_for(t)) ++n;
-      else record_failure(insert_failed_at_, t);
+    std::int64_t n = 0;
+    for (Index t : tets_below(below)) {
+      if (!m_.tet_alive(t) || failed_before(insert_failed_at_, t)) continue;
+      if (insert_for(t))
+        ++n;
+      else
+        record_failure(insert_failed_at_, t);
     }
     return n;
   }
@@ -964,7 +970,7 @@ class Refiner {
       changes += timed("flip", [&] { return flip_pass(std::max(goal, 30.0)); });
       changes += timed("insert", [&] { return insert_pass(std::min(goal, 15.0)); });
       if (round + 1 < rounds && std::isfinite(o_.size)) {
-        const std::size_t slivers = tets_below(std::min(goal, 15.0)).size();
+        const std::size_t slivers = count_below(std::min(goal, 15.0));
         // Curved tet10 elements need room over the curved faces, which these splits give:
         // there the pass goes on while the mesh stays within three times its size after the
         // first size phase (featuretype.STEP meshes at tet10 with it, not without).
