@@ -680,32 +680,41 @@ Index RefineMesh::neighbour(Index t, int k) {
 
 InsertOutcome RefineMesh::insert_point(
     Index start, const Vec3& p, double clearance, Index* new_point, Index max_cavity, bool must_improve,
-    const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>& accept) {
+    const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>& accept, Index must_contain) {
   if (!tet_alive(start)) return InsertOutcome::kWalkFailed;
+  if (must_contain >= 0 && !tet_alive(must_contain)) return InsertOutcome::kWalkFailed;
   // 1. Locate: step through a face that has p strictly beyond it (the faces are tried from a
   //    rotating first index so that the walk does not cycle on a fixed choice).
   Index t = start;
   bool found = false;
   for (int step = 0; step < 4096 && !found; ++step) {
     const auto q = tet(t);
+    // A face with p beyond it; an interior one when there is one (in a non-convex solid a
+    // boundary face can have p beyond it while p is inside, past another face of the tet).
     int beyond = -1;
-    for (int i = 0; i < 4 && beyond < 0; ++i) {
+    bool beyond_boundary = false;
+    for (int i = 0; i < 4 && (beyond < 0 || beyond_boundary); ++i) {
       const int k = (i + step) % 4;
-      if (orient3d(point(q[kOppositeFace[k][0]]), point(q[kOppositeFace[k][1]]), point(q[kOppositeFace[k][2]]), p) == Sign::kNegative)
-        beyond = k;
+      if (orient3d(point(q[kOppositeFace[k][0]]), point(q[kOppositeFace[k][1]]), point(q[kOppositeFace[k][2]]), p) == Sign::kNegative) {
+        const bool boundary = neighbour(t, k) < 0;
+        if (beyond < 0 || !boundary) beyond = k, beyond_boundary = boundary;
+      }
     }
     if (beyond < 0) {
       found = true;
       break;
     }
-    const Index n = neighbour(t, beyond);
-    if (n < 0) return InsertOutcome::kOutside;
-    t = n;
+    if (beyond_boundary) return InsertOutcome::kOutside;
+    t = neighbour(t, beyond);
   }
   if (!found) return InsertOutcome::kWalkFailed;
   // 2. Cavity: tets whose circumsphere contains p, through interior faces.
   std::vector<Index> cavity{t};
   std::unordered_map<Index, char> in{{t, 1}};
+  if (must_contain >= 0 && must_contain != t) {
+    cavity.push_back(must_contain);
+    in.emplace(must_contain, 1);
+  }
   for (std::size_t i = 0; i < cavity.size() && static_cast<Index>(cavity.size()) < max_cavity; ++i)
     for (int k = 0; k < 4; ++k) {
       const Index n = neighbour(cavity[i], k);
@@ -719,6 +728,24 @@ InsertOutcome RefineMesh::insert_point(
         cavity.push_back(n);
       }
     }
+  // 2b. With must_contain: grow through every interior face of the cavity's boundary that p does
+  //     not see from inside (the tet beyond lies between p and the cavity), to at most
+  //     min(max_cavity, 64) tets; tets added are examined in turn.
+  if (must_contain >= 0) {
+    const std::size_t limit = static_cast<std::size_t>(std::min<Index>(max_cavity, 64));
+    for (std::size_t i = 0; i < cavity.size() && cavity.size() < limit; ++i) {
+      const auto q = tet(cavity[i]);
+      for (int k = 0; k < 4 && cavity.size() < limit; ++k) {
+        const Index n = neighbour(cavity[i], k);
+        if (n < 0 || in.count(n)) continue;
+        if (orient3d(point(q[kOppositeFace[k][0]]), point(q[kOppositeFace[k][1]]), point(q[kOppositeFace[k][2]]), p) !=
+            Sign::kPositive) {
+          in.emplace(n, 1);
+          cavity.push_back(n);
+        }
+      }
+    }
+  }
   // 3. Shrink until p sees every boundary face of the cavity strictly from inside (exact).
   struct BFace {
     std::array<Index, 3> v;
@@ -741,7 +768,7 @@ InsertOutcome RefineMesh::insert_point(
     }
     if (drop.empty()) break;
     for (Index c : drop) {
-      if (c == t) return InsertOutcome::kNoStarCavity;
+      if (c == t || c == must_contain) return InsertOutcome::kNoStarCavity;
       in[c] = 0;
     }
   }

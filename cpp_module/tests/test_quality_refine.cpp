@@ -228,6 +228,44 @@ TEST(RefineMesh, InsertPointFillsItsCavityExactlyAndRespectsItsAcceptance) {
   EXPECT_EQ(r.num_alive_tets(), 6);
 }
 
+// A cap: tet (a, b, c, d) under two nearly coplanar boundary faces (a, c, b) and (a, b, d), its
+// circumsphere (centre at z = +30) beyond the surface, and two tets below it down to e. A point
+// below the cap is not in the cap's circumsphere: the plain Bowyer-Watson cavity leaves the cap;
+// with must_contain the cap goes into the cavity (grown through the faces the point does not
+// see) and the cone from the point replaces it.
+TEST(RefineMesh, InsertPointWithMustContainReplacesACapWhoseCircumsphereIsOutside) {
+  const double eps = 0.05;
+  SurfaceMesh s;
+  s.xyz = {0, 0, 0, 4, 0, 0, 2, -1, -eps, 2, 1, -eps, 2, 0, -3};
+  s.tri = {0, 2, 1, 0, 1, 3, 0, 4, 2, 2, 4, 1, 1, 4, 3, 3, 4, 0};
+  TetMesh m;
+  m.xyz = s.xyz;
+  m.tet = {0, 1, 2, 3, 0, 3, 2, 4, 1, 2, 3, 4};
+  ASSERT_TRUE(check_mesh(s, m).valid);
+  const Vec3 below{2.1, 0, -1};
+  {
+    RefineMesh plain(s, m);
+    const double cap = plain.tet_quality(0);
+    EXPECT_LT(cap, 5.0);  // 3.2 degrees
+    Index n = -1;
+    if (plain.insert_point(2, below, 0, &n) == InsertOutcome::kInserted) EXPECT_TRUE(plain.tet_alive(0));
+  }
+  RefineMesh r(s, m);
+  const double before = worst_angle(r);
+  Index n = -1;
+  ASSERT_EQ(r.insert_point(2, below, 0, &n, 512, true, {}, 0), InsertOutcome::kInserted);
+  EXPECT_FALSE(r.tet_alive(0));
+  EXPECT_EQ(r.num_alive_tets(), 6);  // the cone over the six surface triangles
+  const MeshCheckReport rep = check_mesh(s, r.to_tet_mesh());
+  EXPECT_TRUE(rep.valid);
+  EXPECT_EQ(rep.boundary_steiner_points, 0);
+  EXPECT_GT(worst_angle(r), before + 5);
+  // A dead tet cannot be asked for.
+  Index live = 0;
+  while (!r.tet_alive(live)) ++live;
+  EXPECT_EQ(r.insert_point(live, below, 0, nullptr, 512, false, {}, 0), InsertOutcome::kWalkFailed);
+}
+
 TEST(RefineMesh, RelocateIfMovesOnlyInteriorPointsToValidPlacesItsHookAccepts) {
   SurfaceMesh s;
   TetMesh m;

@@ -181,10 +181,15 @@ class RefineMesh {
   /// the new tets exceeds that of the tets they replace (kNoImprovement otherwise).
   /// `accept` (optional) is asked last, with the new tets (the new point as index -1) and p;
   /// false refuses the insertion (kNoImprovement).
+  /// `must_contain` (optional, a live tet): it is put in the cavity whatever its circumsphere, and
+  /// the insertion fails (kNoStarCavity) when it cannot stay there. This is how a flat tet whose
+  /// huge circumsphere lies on the far side of p (a cap on two nearly coplanar boundary faces)
+  /// is replaced by tets from p.
   InsertOutcome insert_point(Index start, const Vec3& p, double clearance, Index* new_point = nullptr,
                              Index max_cavity = 512, bool must_improve = false,
                              const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>&
-                                 accept = {});
+                                 accept = {},
+                             Index must_contain = -1);
   /// Moves interior point v to p when every tet around it stays positive and the smallest min
   /// dihedral around it rises.
   bool relocate_point(Index v, const Vec3& p);
