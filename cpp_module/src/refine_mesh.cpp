@@ -682,7 +682,20 @@ InsertOutcome RefineMesh::insert_point(
     Index start, const Vec3& p, double clearance, Index* new_point, Index max_cavity, bool must_improve,
     const std::function<bool(const std::vector<std::array<Index, 4>>&, const Vec3&)>& accept, Index must_contain) {
   if (!tet_alive(start)) return InsertOutcome::kWalkFailed;
-  if (must_contain >= 0 && !tet_alive(must_contain)) return InsertOutcome::kWalkFailed;
+  if (must_contain >= 0) {
+    if (!tet_alive(must_contain)) return InsertOutcome::kWalkFailed;
+    // A boundary face of must_contain stays a face of the cavity: p must see it from inside, and
+    // with must_improve the tet it makes with p should be better than must_contain (exactly what
+    // is asked when must_contain is the cavity's worst tet, as it is for the callers).
+    const auto q = tet(must_contain);
+    for (int k = 0; k < 4; ++k) {
+      if (neighbour(must_contain, k) >= 0) continue;
+      const Vec3 &a = point(q[kOppositeFace[k][0]]), &b = point(q[kOppositeFace[k][1]]), &c = point(q[kOppositeFace[k][2]]);
+      if (orient3d(a, b, c, p) != Sign::kPositive) return InsertOutcome::kNoStarCavity;
+      if (must_improve && tet_min_dihedral_deg(a, b, c, p) <= tet_quality(must_contain) + kImprovement)
+        return InsertOutcome::kNoImprovement;
+    }
+  }
   // 1. Locate: step through a face that has p strictly beyond it (the faces are tried from a
   //    rotating first index so that the walk does not cycle on a fixed choice).
   Index t = start;
