@@ -562,13 +562,11 @@ bool RefineMesh::flip32(Index u, Index v, const TetsAccept& accept) {
   return remove_edge(u, v, 3, accept, 3);
 }
 
-bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& accept, int min_ring) {
-  const std::vector<Index> shell = tets_around_edge(u, v);
-  const int n = static_cast<int>(shell.size());
-  if (n < std::max(3, min_ring) || n > max_ring) return false;
-  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
-  // The ring: for every tet {u, v, p, q} (an even permutation of its corners), q follows p.
-  std::vector<std::pair<Index, Index>> links;
+// The shell of edge (u, v): for every tet {u, v, p, q} (an even permutation of its corners) the
+// link p -> q. False when a tet of the shell is degenerate in this respect.
+bool RefineMesh::shell_links(Index u, Index v, const std::vector<Index>& shell,
+                             std::vector<std::pair<Index, Index>>& links) const {
+  links.clear();
   for (Index s : shell) {
     const auto& r = tet(s);
     Index p = -1, q = -1;
@@ -578,6 +576,16 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
     if (!even_permutation(r, {u, v, p, q})) std::swap(p, q);
     links.emplace_back(p, q);
   }
+  return true;
+}
+
+bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& accept, int min_ring) {
+  const std::vector<Index> shell = tets_around_edge(u, v);
+  const int n = static_cast<int>(shell.size());
+  if (n < std::max(3, min_ring) || n > max_ring) return false;
+  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
+  std::vector<std::pair<Index, Index>> links;
+  if (!shell_links(u, v, shell, links)) return false;
   std::vector<Index> ring{links[0].first};
   for (int i = 0; i < n; ++i) {
     auto it = std::find_if(links.begin(), links.end(), [&](const auto& l) { return l.first == ring.back(); });
@@ -586,6 +594,52 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
   }
   if (ring.back() != ring.front()) return false;
   ring.pop_back();
+  return retriangulate_shell(u, v, shell, ring, /*open=*/false, -1, accept);
+}
+
+bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAccept& accept, bool only_if_not_delaunay) {
+  const std::vector<Index> shell = tets_around_edge(u, v);
+  const int n = static_cast<int>(shell.size());
+  if (n < 2 || n > max_ring) return false;
+  Index parent = -1, other = -1;
+  if (edge_kind(u, v, &parent, &other) != EdgeKind::kInFace) return false;
+  std::vector<std::pair<Index, Index>> links;
+  if (!shell_links(u, v, shell, links)) return false;
+  // The open chain a = w_0 .. w_n = b: it starts at the link whose tail no link ends at.
+  Index first = -1;
+  for (const auto& l : links)
+    if (std::none_of(links.begin(), links.end(), [&](const auto& m) { return m.second == l.first; })) {
+      if (first >= 0) return false;
+      first = l.first;
+    }
+  if (first < 0) return false;
+  std::vector<Index> chain{first};
+  for (int i = 0; i < n; ++i) {
+    auto it = std::find_if(links.begin(), links.end(), [&](const auto& l) { return l.first == chain.back(); });
+    if (it == links.end()) return false;
+    chain.push_back(it->second);
+  }
+  // (u, v, a) and (u, v, b) must be the boundary faces, and the new edge (a, b) must not exist.
+  const auto is_boundary = [&](Index a, Index b, Index c) { return boundary_.count(face_key(a, b, c)) != 0; };
+  if (!is_boundary(u, v, chain.front()) || !is_boundary(u, v, chain.back())) return false;
+  if (edge_exists(chain.front(), chain.back())) return false;
+  if (only_if_not_delaunay) {
+    // The angles at a and b facing (u, v), in doubles (a choice, not a validity decision).
+    const auto angle = [&](Index apex) {
+      const Vec3 &p = point(apex), &x = point(u), &y = point(v);
+      const double ax = x.x - p.x, ay = x.y - p.y, az = x.z - p.z, bx = y.x - p.x, by = y.y - p.y, bz = y.z - p.z;
+      const double c = (ax * bx + ay * by + az * bz) /
+                       std::sqrt((ax * ax + ay * ay + az * az) * (bx * bx + by * by + bz * bz));
+      return std::acos(std::max(-1.0, std::min(1.0, c)));
+    };
+    if (!(angle(chain.front()) + angle(chain.back()) > std::acos(-1.0))) return false;
+  }
+  return retriangulate_shell(u, v, shell, chain, /*open=*/true, parent, accept);
+}
+
+bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>& shell, const std::vector<Index>& ring,
+                                     bool open, Index parent, const TetsAccept& accept) {
+  const int n = static_cast<int>(ring.size());
   {
     std::vector<Index> sorted = ring;
     std::sort(sorted.begin(), sorted.end());
@@ -596,8 +650,8 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
   const auto tets_of = [&](int i, int k, int j) {
     return std::array<std::array<Index, 4>, 2>{{{W(k), W(i), W(j), u}, {W(i), W(k), W(j), v}}};
   };
-  // Diagonals (i, j), j - i >= 2, (i, j) != (0, n - 1), must not be mesh edges yet; the single
-  // triangle of n = 3 must not be a mesh face.
+  // Diagonals (i, j), j - i >= 2, (i, j) != (0, n - 1), must not be mesh edges yet (the caller
+  // checked (0, n - 1) for an open chain); the single triangle of n = 3 must not be a mesh face.
   std::vector<char> diagonal_ok(static_cast<std::size_t>(n * n), 1);
   for (int i = 0; i < n; ++i)
     for (int j = i + 2; j < n; ++j)
@@ -656,6 +710,13 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
     if (!accept(removed, created)) return false;
   }
   for (Index s : shell) kill_tet(s);
+  if (open) {
+    // The two boundary faces on the old edge give way to the two on the new one, same parent.
+    boundary_.erase(face_key(u, v, W(0)));
+    boundary_.erase(face_key(u, v, W(n - 1)));
+    boundary_.emplace(face_key(W(0), W(n - 1), u), parent);
+    boundary_.emplace(face_key(W(0), W(n - 1), v), parent);
+  }
   for (const auto& c : created) add_tet(c);
   return true;
 }

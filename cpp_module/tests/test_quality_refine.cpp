@@ -299,6 +299,42 @@ TEST(QualityRefine, BoxWithHoleToSizeIsValidAndBetterShaped) {
   EXPECT_EQ(st.splits_no_exact_point, 0);
 }
 
+// flip_boundary_edge on every boundary edge inside one input triangle of a refined mesh (exact
+// mode: box_with_hole's axis-aligned facets are split exactly), each accepted whatever its angles:
+// after every flip the mesh is still an exact refinement of the input (the check is against the
+// INPUT surface), and edges between two input triangles are never flipped.
+TEST(RefineMesh, BoundaryEdgeFlipsKeepTheMeshAnExactRefinementOfTheInput) {
+  const SurfaceMesh s = read_off(data("paper/box_with_hole.off"));
+  RefineOptions o;
+  o.size = 0.5;
+  o.optimize_rounds = 0;
+  const TetMesh refined = refine_quality(s, tetrahedralize(s), o);
+  RefineMesh r(s, refined);
+  const auto any = [](const std::vector<std::array<Index, 4>>&, const std::vector<std::array<Index, 4>>&) {
+    return true;
+  };
+  int in_face = 0, flipped = 0, on_input_edge = 0;
+  for (const auto& e : r.edges()) {
+    if (!r.edge_exists(e[0], e[1])) continue;  // an earlier flip removed it
+    const EdgeKind k = r.edge_kind(e[0], e[1]);
+    if (k == EdgeKind::kOnInputEdge) {
+      ++on_input_edge;
+      EXPECT_FALSE(r.flip_boundary_edge(e[0], e[1], 7, any));
+    }
+    if (k != EdgeKind::kInFace) continue;
+    ++in_face;
+    if (!r.flip_boundary_edge(e[0], e[1], 7, any)) continue;
+    ++flipped;
+    EXPECT_FALSE(r.edge_exists(e[0], e[1]));
+    if (flipped % 25 == 1) ASSERT_TRUE(check_mesh(s, r.to_tet_mesh()).valid) << "after flip " << flipped;
+  }
+  const MeshCheckReport rep = check_mesh(s, r.to_tet_mesh());
+  EXPECT_TRUE(rep.valid);
+  EXPECT_GT(in_face, 50);
+  EXPECT_GT(on_input_edge, 0);
+  EXPECT_GT(flipped, 10);
+}
+
 TEST(QualityRefine, BadOptionsAreInputErrors) {
   const SurfaceMesh s = read_off(data("paper/dented_box.off"));
   const TetMesh core = tetrahedralize(s);

@@ -125,6 +125,8 @@ class RefineMesh {
   /// Kind of edge (u, v); for boundary edges `tri_a`/`tri_b` receive the two parents (equal for
   /// kInFace). Precondition: (u, v) is an edge.
   EdgeKind edge_kind(Index u, Index v, Index* tri_a = nullptr, Index* tri_b = nullptr);
+  /// True when (u, v) is an edge of a live tet.
+  bool edge_exists(Index u, Index v);
   /// Every edge of the live tets once, as (min, max) pairs in lexicographic order.
   std::vector<std::array<Index, 2>> edges() const;
   /// Face tag of input triangle t (-1 when the surface has no tags).
@@ -165,6 +167,25 @@ class RefineMesh {
   /// interior, the ring faces stay). Shells of fewer than `min_ring` tets are left (callers that
   /// tried flip32 first pass 4).
   bool remove_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {}, int min_ring = 3);
+  /// Flip of a boundary edge (u, v) inside one input triangle (EdgeKind::kInFace): its boundary
+  /// faces (u, v, a) and (v, u, b) become (a, b, u) and (b, a, v), same parent, and the n tets
+  /// around it (2 <= n <= max_ring; their other corners form the open chain a = w_0 .. w_n = b)
+  /// are replaced by the best triangulation of the polygon w_0 .. w_n, closed by the new edge
+  /// (a, b), each triangle joined to u and to v (the same dynamic programming and acceptance as
+  /// remove_edge). Why the result is valid: every new tet is positive (exact); in exact mode
+  /// u, v, a, b lie exactly on their parent's plane, so the two new faces tile the two old ones
+  /// (two triangulations of one planar quad) and the argument of remove_edge applies: the new
+  /// tets fill the old ones' union exactly once. In rounded and projection modes the four points
+  /// are within rounding of (or on the true surface over) the parent, not exactly coplanar: the
+  /// boundary then changes by the thin tet (u, v, a, b), like a split's rounded point does, and
+  /// the mesh stays valid against its own boundary (positive, conforming, closed).
+  /// With `only_if_not_delaunay`, only when the angles at a and b facing (u, v) add up to more
+  /// than 180 degrees (the edge is not locally Delaunay in its facet).
+  /// The quality driver does not call it yet: in its flip pass (rounded mode, 6 CAD models at
+  /// h = diagonal / 20) it raised the worst angle on some models and lowered it on others, with or
+  /// without the Delaunay condition (docs/quality-stage.md, session 16).
+  bool flip_boundary_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {},
+                          bool only_if_not_delaunay = false);
   /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
   /// tet `start` that never crosses a boundary face (kOutside when it would: p is outside the
   /// solid or on its boundary). The cavity is the tets whose circumsphere contains p (computed in
@@ -223,7 +244,11 @@ class RefineMesh {
   double quality_of(const std::array<Index, 4>& t) const;
   /// Input triangles whose closed triangle contains point v (by support).
   bool support_allows_collapse(Index from, Index to) const;
-  bool edge_exists(Index u, Index v);
+  bool shell_links(Index u, Index v, const std::vector<Index>& shell, std::vector<std::pair<Index, Index>>& links) const;
+  /// remove_edge and flip_boundary_edge after their checks: `ring` is the closed ring (open =
+  /// false) or the open chain from a to b (open = true; `parent` the boundary faces' parent).
+  bool retriangulate_shell(Index u, Index v, const std::vector<Index>& shell, const std::vector<Index>& ring,
+                           bool open, Index parent, const TetsAccept& accept);
   /// The live tet other than t sharing t's face opposite its vertex k; -1 on the boundary.
   Index neighbour(Index t, int k);
 
