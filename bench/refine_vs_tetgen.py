@@ -19,6 +19,7 @@ Models the core cannot mesh are listed with the core's message.
 """
 
 import argparse
+import json
 import os
 import statistics
 import sys
@@ -70,6 +71,7 @@ def main():
     ap.add_argument("--timeout", type=float, default=600.0)
     ap.add_argument("--png", default=os.path.join(ROOT, "out", "refine_vs_tetgen.png"))
     ap.add_argument("--markdown", default=None)
+    ap.add_argument("--json", default=None, help="write every row (unrounded figures, histograms) here")
     args = ap.parse_args()
     modes = [m for m in args.modes.split(",") if m]
     rows = []
@@ -125,6 +127,9 @@ def main():
     _plot(rows, modes, args.png)
     if args.markdown:
         _markdown(rows, summary, args)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"divisions": args.divisions, "modes": modes, "summary": summary, "rows": rows}, f)
 
 
 def _plot(rows, modes, png):
@@ -164,22 +169,28 @@ def _plot(rows, modes, png):
     print(f"histograms: {png}")
 
 
+def _deg(x):
+    """An angle in degrees for the report: two decimals, or two significant digits below 0.1
+    (so that 0.0004 and 0.003, both "0.00" with two decimals, can be told apart)."""
+    return f"{x:.2f}" if x >= 0.1 or x == 0 else f"{x:.2g}"
+
+
 def _markdown(rows, summary, args):
     lines = [f"h = bounding-box diagonal / {args.divisions:g}; TetGen: `tetgen -pq1.414a<V>`, "
              "V = h^3/(6 sqrt 2)", "",
-             "| model | mode | ours tets | ours min / p1 dihedral | TetGen tets | TetGen min / p1 | "
-             "tets ratio | TetGen mesh exact-valid |", "|---|---|---|---|---|---|---|---|"]
+             "| model | mode | ours tets | ours min / p1 dihedral | ours s | TetGen tets | TetGen min / p1 | "
+             "TetGen s | tets ratio | TetGen mesh exact-valid |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         o, t = r["ours"], r["tg"]
         if "error" in o:
-            lines.append(f"| {r['name']} | {r['mode']} | failed: {o['error']} | | | | | |")
+            lines.append(f"| {r['name']} | {r['mode']} | failed: {o['error']} | | | | | | | |")
         elif t is None or "error" in t:
-            lines.append(f"| {r['name']} | {r['mode']} | {o['tets']} | {o['min']:.2f} / {o['p1']:.2f} "
-                         "| tetgen failed | | | |")
+            lines.append(f"| {r['name']} | {r['mode']} | {o['tets']} | {_deg(o['min'])} / {o['p1']:.2f} "
+                         f"| {o['seconds']:.1f} | tetgen failed | | | | |")
         else:
-            lines.append(f"| {r['name']} | {r['mode']} | {o['tets']} | {o['min']:.2f} / {o['p1']:.2f} | "
-                         f"{t['tets']} | {t['min']:.2f} / {t['p1']:.2f} | {r['ratio']:.2f} | "
-                         f"{'yes' if t['valid'] else 'no'} |")
+            lines.append(f"| {r['name']} | {r['mode']} | {o['tets']} | {_deg(o['min'])} / {o['p1']:.2f} | "
+                         f"{o['seconds']:.1f} | {t['tets']} | {_deg(t['min'])} / {t['p1']:.2f} | "
+                         f"{t['seconds']:.1f} | {r['ratio']:.2f} | {'yes' if t['valid'] else 'no'} |")
     lines += [""] + [f"- {s}" for s in summary]
     with open(args.markdown, "w") as f:
         f.write("\n".join(lines) + "\n")
