@@ -535,8 +535,7 @@ class Refiner {
           // Over the face at the height of a regular tet (or less), then on the segment from the
           // face's centroid to the opposite corner (thin walls, where the first points fall out).
           std::vector<Vec3> cand;
-          for (double f : {1.0, 0.5, 0.25})
-            if (f == 1.0 || !curved_tet10()) cand.push_back(fr.apex(f));
+          for (double f : {1.0, 0.5, 0.25}) cand.push_back(fr.apex(f));
           for (double lambda : {0.5, 0.33, 0.67})
             cand.push_back({G.x + lambda * (D.x - G.x), G.y + lambda * (D.y - G.y), G.z + lambda * (D.z - G.z)});
           for (const Vec3& x : cand) {
@@ -1003,8 +1002,8 @@ class Refiner {
 
   // Curved tet10 through a projection hook (FreeCAD's tet10). Its insertion and sliver passes
   // stay as they were before session 16 (no forced tet, one height, the h / 8 clearance floor,
-  // sliver splits not held to the worst angle; only insert_point's walk is the new one): the curving stage after them needs the room those
-  // left over curved faces. With session 16's passes 9 of the 13 CAD corpus files meshed at tet10
+  // sliver splits not held to the worst angle; only insert_point's walk is the new one): the
+  // curving stage after them needs the room those left over curved faces. With session 16's passes 9 of the 13 CAD corpus files meshed at tet10
   // instead of 10 (featuretype.STEP and bottle.brep stopped with inverted curved elements,
   // SampleCrankshaft4A meshed).
   bool curved_tet10() const { return o_.order == 2 && static_cast<bool>(o_.projection); }

@@ -601,8 +601,8 @@ bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAc
   const std::vector<Index> shell = tets_around_edge(u, v);
   const int n = static_cast<int>(shell.size());
   if (n < 2 || n > max_ring) return false;
-  Index parent = -1, other = -1;
-  if (edge_kind(u, v, &parent, &other) != EdgeKind::kInFace) return false;
+  Index parent = -1;
+  if (edge_kind(u, v, &parent) != EdgeKind::kInFace) return false;
   std::vector<std::pair<Index, Index>> links;
   if (!shell_links(u, v, shell, links)) return false;
   // The open chain a = w_0 .. w_n = b: it starts at the link whose tail no link ends at.
@@ -804,9 +804,9 @@ InsertOutcome RefineMesh::insert_point(
     }
   // 2b. With must_contain: grow through every interior face of the cavity's boundary that p does
   //     not see from inside (the tet beyond lies between p and the cavity), to at most
-  //     min(max_cavity, 64) tets; tets added are examined in turn.
+  //     max_cavity tets; tets added are examined in turn.
   if (must_contain >= 0) {
-    const std::size_t limit = static_cast<std::size_t>(std::min<Index>(max_cavity, 64));
+    const std::size_t limit = static_cast<std::size_t>(max_cavity);
     for (std::size_t i = 0; i < cavity.size() && cavity.size() < limit; ++i) {
       const auto q = tet(cavity[i]);
       for (int k = 0; k < 4 && cavity.size() < limit; ++k) {
