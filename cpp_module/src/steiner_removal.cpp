@@ -729,8 +729,6 @@ class TetComplex {
       const int i = f[0] < f[1] ? (f[0] < f[2] ? 0 : 2) : (f[1] < f[2] ? 1 : 2);
       return std::array<Index, 3>{f[i], f[(i + 1) % 3], f[(i + 2) % 3]};
     };
-    std::set<std::array<Index, 3>> front;
-    for (const auto& f : bnd) front.insert(canon(f));
     std::map<std::array<Index, 3>, std::vector<Index>> apexes;  // face -> vertices on its inner side
     auto candidates = [&](const std::array<Index, 3>& f) -> const std::vector<Index>& {
       auto it = apexes.find(f);
@@ -741,20 +739,27 @@ class TetComplex {
           out.push_back(p);
       return apexes.emplace(f, std::move(out)).first->second;
     };
+    // The front, and the same faces ordered by (number of apexes, face): its first element is the
+    // face the search fills next (the fewest apexes; among equals the smallest face).
+    std::map<std::array<Index, 3>, std::size_t> front;
+    std::set<std::pair<std::size_t, std::array<Index, 3>>> by_apexes;
+    auto front_insert = [&](const std::array<Index, 3>& f) {
+      const std::size_t n = candidates(f).size();
+      front.emplace(f, n);
+      by_apexes.insert({n, f});
+    };
+    auto front_erase = [&](std::map<std::array<Index, 3>, std::size_t>::iterator it) {
+      by_apexes.erase({it->second, it->first});
+      front.erase(it);
+    };
+    for (const auto& f : bnd) front_insert(canon(f));
     std::vector<std::array<Index, 4>> repl;
     std::size_t nodes = 0;
     std::function<bool()> search = [&]() -> bool {
       if (front.empty()) return true;
       if (++nodes > max_nodes) return false;
-      // The front face with the fewest apexes (none: a dead end).
-      const std::array<Index, 3>* best = nullptr;
-      std::size_t fewest = SIZE_MAX;
-      for (const auto& f : front) {
-        const std::size_t n = candidates(f).size();
-        if (n < fewest) fewest = n, best = &f;
-        if (n == 0) return false;
-      }
-      const std::array<Index, 3> f = *best;
+      if (by_apexes.begin()->first == 0) return false;  // a face no tet can fill: a dead end
+      const std::array<Index, 3> f = by_apexes.begin()->second;
       const std::vector<Index> cs = candidates(f);
       for (Index p : cs) {
         const std::array<Index, 4> t{f[0], f[2], f[1], p};
@@ -765,14 +770,14 @@ class TetComplex {
         bool fits = true;
         for (const auto& g : tf) {
           const auto k = canon(g), r = canon({g[0], g[2], g[1]});
-          if (front.count(k)) {
-            front.erase(k);
+          if (auto it = front.find(k); it != front.end()) {
+            front_erase(it);
             undo.push_back({true, k});
           } else if (front.count(r)) {
             fits = false;  // t would lie on the filled side of r
             break;
           } else {
-            front.insert(r);
+            front_insert(r);
             undo.push_back({false, r});
           }
         }
@@ -782,8 +787,8 @@ class TetComplex {
           repl.pop_back();
         }
         for (auto it = undo.rbegin(); it != undo.rend(); ++it)
-          if (it->first) front.insert(it->second);
-          else front.erase(it->second);
+          if (it->first) front_insert(it->second);
+          else front_erase(front.find(it->second));
         if (nodes > max_nodes) return false;
       }
       return false;
@@ -1365,7 +1370,7 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
       check_cancel();
       if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
       for (int layers = 0; layers <= 5 && affordable(v); ++layers)
-        if (charged(v, [&] { return mesh.retetrahedralize(v, layers, 120, 5000); })) {
+        if (charged(v, [&] { return mesh.retetrahedralize(v, layers, 120, 1000); })) {
           ++st.collapsed;
           break;
         }
