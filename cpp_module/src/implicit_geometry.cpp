@@ -489,6 +489,9 @@ Sign ImplicitGeometry::lifted_det3(Index a, Index b, Index c, Index d, Index e) 
                  : lifted_det3_uncertain(m.data(), r.data(), m[4], r[4], s)) &&
           s != Sign::kZero)
         return s;
+      // Five doubles (the Delaunay seed's case), which the double filter cannot decide: points
+      // rounded onto a sphere or a cylinder mostly. The same filter in extended precision.
+      if (exact && lifted_det3_filter_extended(m[0], m[1], m[2], m[3], m[4], s) && s != Sign::kZero) return s;
     }
   }
   int s0 = 0;

@@ -1,6 +1,7 @@
 #include "bsptet/predicates.h"
 
 #include <cmath>
+#include <limits>
 
 #include "bsptet/exact_float.h"
 
@@ -334,32 +335,52 @@ bool lifted_det2_uncertain(const Vec3* p, const double* rp, const Vec3& e, doubl
   return true;
 }
 
-bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out) {
+namespace {
+// lifted_det3_filter in the floating-point type T whose unit roundoff is `unit` (double: 2^-53;
+// x87 extended long double: 2^-64). The evaluation has depth 10 in rounded operations, the
+// coordinate differences included; its error stays under 11 unit times the permanent (itself
+// rounded over at most 10 operations): 16 unit leaves room, in either format.
+template <typename T>
+bool lifted_det3_filter_in(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, T unit,
+                           Sign& out) {
   const Vec3* rows[4] = {&a, &b, &c, &d};
-  double x[4], y[4], z[4], l[4], la[4];
+  T x[4], y[4], z[4], l[4];
   for (int i = 0; i < 4; ++i) {
-    x[i] = rows[i]->x - e.x, y[i] = rows[i]->y - e.y, z[i] = rows[i]->z - e.z;
-    l[i] = x[i] * x[i] + y[i] * y[i] + z[i] * z[i];
-    la[i] = l[i];  // already a sum of non-negative terms
+    x[i] = T(rows[i]->x) - T(e.x), y[i] = T(rows[i]->y) - T(e.y), z[i] = T(rows[i]->z) - T(e.z);
+    l[i] = x[i] * x[i] + y[i] * y[i] + z[i] * z[i];  // a sum of non-negative terms: its own permanent
   }
+  using std::fabs;
   // 2x2 minors of the (x, y) columns and their permanents.
   auto m = [&](int i, int j) { return x[i] * y[j] - x[j] * y[i]; };
-  auto pm = [&](int i, int j) { return std::fabs(x[i] * y[j]) + std::fabs(x[j] * y[i]); };
-  const double m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3), m23 = m(2, 3);
-  const double p01 = pm(0, 1), p02 = pm(0, 2), p03 = pm(0, 3), p12 = pm(1, 2), p13 = pm(1, 3), p23 = pm(2, 3);
+  auto pm = [&](int i, int j) { return fabs(x[i] * y[j]) + fabs(x[j] * y[i]); };
+  const T m01 = m(0, 1), m02 = m(0, 2), m03 = m(0, 3), m12 = m(1, 2), m13 = m(1, 3), m23 = m(2, 3);
+  const T p01 = pm(0, 1), p02 = pm(0, 2), p03 = pm(0, 3), p12 = pm(1, 2), p13 = pm(1, 3), p23 = pm(2, 3);
   // det3 of rows (i, j, k) over (x, y, z) = z_i m_jk - z_j m_ik + z_k m_ij.
-  const double d123 = (z[1] * m23 - z[2] * m13) + z[3] * m12, d023 = (z[0] * m23 - z[2] * m03) + z[3] * m02,
-               d013 = (z[0] * m13 - z[1] * m03) + z[3] * m01, d012 = (z[0] * m12 - z[1] * m02) + z[2] * m01;
-  const double q123 = (std::fabs(z[1]) * p23 + std::fabs(z[2]) * p13) + std::fabs(z[3]) * p12,
-               q023 = (std::fabs(z[0]) * p23 + std::fabs(z[2]) * p03) + std::fabs(z[3]) * p02,
-               q013 = (std::fabs(z[0]) * p13 + std::fabs(z[1]) * p03) + std::fabs(z[3]) * p01,
-               q012 = (std::fabs(z[0]) * p12 + std::fabs(z[1]) * p02) + std::fabs(z[2]) * p01;
+  const T d123 = (z[1] * m23 - z[2] * m13) + z[3] * m12, d023 = (z[0] * m23 - z[2] * m03) + z[3] * m02,
+          d013 = (z[0] * m13 - z[1] * m03) + z[3] * m01, d012 = (z[0] * m12 - z[1] * m02) + z[2] * m01;
+  const T q123 = (fabs(z[1]) * p23 + fabs(z[2]) * p13) + fabs(z[3]) * p12,
+          q023 = (fabs(z[0]) * p23 + fabs(z[2]) * p03) + fabs(z[3]) * p02,
+          q013 = (fabs(z[0]) * p13 + fabs(z[1]) * p03) + fabs(z[3]) * p01,
+          q012 = (fabs(z[0]) * p12 + fabs(z[1]) * p02) + fabs(z[2]) * p01;
   // Laplace expansion on the lift column (index 3): cofactor signs -, +, -, + for rows 0..3.
-  const double det = ((l[1] * d023 - l[0] * d123) + l[3] * d012) - l[2] * d013;
-  const double perm = ((la[1] * q023 + la[0] * q123) + la[3] * q012) + la[2] * q013;
-  if (!(std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > kLiftedBound * perm)) return false;
-  out = sign_of(det);
+  const T det = ((l[1] * d023 - l[0] * d123) + l[3] * d012) - l[2] * d013;
+  const T perm = ((l[1] * q023 + l[0] * q123) + l[3] * q012) + l[2] * q013;
+  using std::isfinite;
+  if (!(isfinite(perm) && perm > T(kUnderflowGuard) && fabs(det) > 16 * unit * perm)) return false;
+  out = det > 0 ? Sign::kPositive : (det < 0 ? Sign::kNegative : Sign::kZero);
   return true;
+}
+}  // namespace
+
+bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out) {
+  return lifted_det3_filter_in<double>(a, b, c, d, e, kUnitRoundoff, out);
+}
+
+bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e,
+                                 Sign& out) {
+  static_assert(std::numeric_limits<long double>::digits >= 64, "needs x87 extended precision (64-bit significand)");
+  return lifted_det3_filter_in<long double>(a, b, c, d, e, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
+                                            out);
 }
 
 bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {

@@ -228,6 +228,7 @@ TEST(LiftedFilters, AgreeWithExact) {
       ++certified;
       ASSERT_EQ(static_cast<int>(f), ex3) << "it " << it;
     }
+    if (lifted_det3_filter_extended(p[0], p[1], p[2], p[3], p[4], f)) ASSERT_EQ(static_cast<int>(f), ex3) << "it " << it;
     const int axis = it % 3;
     const int ex2 = exact_lifted_det2(p, p[3], axis);
     if (lifted_det2_filter(p[0], p[1], p[2], p[3], axis, f)) ASSERT_EQ(static_cast<int>(f), ex2) << "it " << it;
@@ -235,6 +236,47 @@ TEST(LiftedFilters, AgreeWithExact) {
   std::printf("lifted_det3: %d of %d certified, %d exact zeros\n", certified, trials, zeros);
   EXPECT_GT(zeros, 1000);           // the degenerate cases were really made
   EXPECT_GT(certified, trials / 5);  // and the filter decides the random quarter (the rest is built degenerate)
+}
+
+// The extended-precision lifted filter where the double one fails: five points rounded onto one
+// sphere (a cube-sphere, a CAD sphere), four rounded onto a circle and a fifth near it (a CAD
+// cylinder's ring), shifted and scaled. Every certified sign must be the exact one, and it must
+// certify most of them (that is its purpose: the Delaunay seed of such surfaces went to GMP).
+TEST(LiftedFilters, ExtendedPrecisionDecidesRoundedSpheres) {
+  const unsigned seed = 20261203u;
+  std::printf("seed %u\n", seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1), angle(0, 6.283185307179586);
+  std::uniform_int_distribution<int> scale_exp(-60, 60);
+  int by_double = 0, by_extended = 0, nonzero = 0;
+  for (int it = 0; it < 20000; ++it) {
+    const double s = std::ldexp(1.0, scale_exp(rng)), shift = (it % 3 == 0) ? 100.0 : 0.0;
+    Vec3 p[5];
+    for (int i = 0; i < 5; ++i) {
+      if (it % 2 == 0) {
+        const double t = angle(rng), z = U(rng), r = std::sqrt(1 - z * z);
+        p[i] = {r * std::cos(t), r * std::sin(t), z};
+      } else {
+        const double t = angle(rng);
+        p[i] = i < 4 ? Vec3{std::cos(t), std::sin(t), 0.5} : Vec3{std::cos(t) * (1 + 1e-9 * U(rng)), std::sin(t), 0.5 + 1e-3 * U(rng)};
+      }
+      p[i] = {(p[i].x + shift) * s, p[i].y * s, (p[i].z - shift) * s};
+    }
+    const int want = exact_lifted_det3(p, p[4]);
+    nonzero += want != 0;
+    Sign f;
+    if (lifted_det3_filter(p[0], p[1], p[2], p[3], p[4], f)) {
+      ++by_double;
+      ASSERT_EQ(static_cast<int>(f), want) << "it " << it;
+    }
+    if (lifted_det3_filter_extended(p[0], p[1], p[2], p[3], p[4], f)) {
+      ++by_extended;
+      ASSERT_EQ(static_cast<int>(f), want) << "it " << it;
+    }
+  }
+  std::printf("certified: double %d, extended %d, of %d nonzero\n", by_double, by_extended, nonzero);
+  EXPECT_LT(by_double, nonzero / 2);
+  EXPECT_GT(by_extended, nonzero * 8 / 10);
 }
 
 // The filters for approximately known points: the exact points p are doubles (so the exact sign

@@ -51,6 +51,12 @@ bool orient2d_uncertain(const Vec3& a, double ra, const Vec3& b, double rb, cons
 /// proven error bound certifies the sign; false (out unset) when the caller must decide exactly.
 bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e, Sign& out);
 bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out);
+/// lifted_det3_filter evaluated in x87 extended precision (64-bit significand, its own proven
+/// bound): about 2^11 times tighter, so it certifies most points rounded onto a common sphere or
+/// circle (a CAD cylinder's rings, a cube-sphere), where the double filter fails, at a fraction
+/// of the exact computation's cost.
+bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e,
+                                 Sign& out);
 /// The same determinants (unperturbed) for approximately known points, as orient3d_uncertain:
 /// p[0..3] (lifted_det3; p[0..2] for lifted_det2) within rp[i] of the exact points, e (the last
 /// row: e for lifted_det3, d for lifted_det2) within re.
