@@ -379,6 +379,11 @@ bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e,
                                  Sign& out) {
   static_assert(std::numeric_limits<long double>::digits >= 64, "needs x87 extended precision (64-bit significand)");
+  // The bound needs the 64-bit significand at run time too: code that lowers the x87 precision
+  // control (or an emulator such as valgrind, which computes long double in double) would make
+  // it unsound. Then decline (the caller decides exactly).
+  volatile long double one = 1.0L;
+  if (one + 0x1p-63L == one) return false;
   return lifted_det3_filter_in<long double>(a, b, c, d, e, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
                                             out);
 }

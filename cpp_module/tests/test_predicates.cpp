@@ -243,6 +243,8 @@ TEST(LiftedFilters, AgreeWithExact) {
 // cylinder's ring), shifted and scaled. Every certified sign must be the exact one, and it must
 // certify most of them (that is its purpose: the Delaunay seed of such surfaces went to GMP).
 TEST(LiftedFilters, ExtendedPrecisionDecidesRoundedSpheres) {
+  volatile long double one = 1.0L;
+  if (one + 0x1p-63L == one) GTEST_SKIP() << "long double has no 64-bit significand here (valgrind?): the filter declines";
   const unsigned seed = 20261203u;
   std::printf("seed %u\n", seed);
   std::mt19937_64 rng(seed);
