@@ -288,6 +288,9 @@ bool RefineMesh::edge_exists(Index u, Index v) {
 }
 
 EdgeKind RefineMesh::edge_kind(Index u, Index v, Index* tri_a, Index* tri_b) {
+  // A boundary edge has both ends on the boundary; an interior point never is (supports are kept
+  // exact: only surface splits and the constructor make boundary points).
+  if (support(u).kind == Support::kInterior || support(v).kind == Support::kInterior) return EdgeKind::kInterior;
   std::vector<std::pair<FaceKey, Index>> found;
   for (Index t : tets_around_edge(u, v))
     for (Index x : tet(t)) {
@@ -662,12 +665,17 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
   // best[i][j]: the best worst angle of a triangulation of the sub-polygon i..j (j - i >= 2);
   // -1: none is valid.
   const double kNone = -1;
+  double old_min = 180;
+  for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
+  // Without `accept` only a triangulation better than the shell counts: a sub-polygon whose best
+  // is no better than that is as good as none (the same optimum, found with fewer tets looked at).
+  const double floor_q = accept ? kNone : old_min + kImprovement;
   std::vector<double> best(static_cast<std::size_t>(n * n), std::numeric_limits<double>::infinity());
   std::vector<int> choice(static_cast<std::size_t>(n * n), -1);
   for (int len = 2; len < n; ++len)
     for (int i = 0; i + len < n; ++i) {
       const int j = i + len;
-      double b = kNone;
+      double b = floor_q;
       int c = -1;
       if (diagonal_ok[static_cast<std::size_t>(i * n + j)])
         for (int k = i + 1; k < j; ++k) {
@@ -690,8 +698,6 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
     }
   const double got = best[static_cast<std::size_t>(n - 1)];
   if (got <= kNone) return false;
-  double old_min = 180;
-  for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
   if (!accept && got <= old_min + kImprovement) return false;
   std::vector<std::array<Index, 4>> created;
   std::vector<std::pair<int, int>> todo{{0, n - 1}};
@@ -783,22 +789,27 @@ InsertOutcome RefineMesh::insert_point(
   }
   if (!found) return InsertOutcome::kWalkFailed;
   // 2. Cavity: tets whose circumsphere contains p, through interior faces.
+  if (cavity_mark_.size() < tets_.size()) cavity_mark_.resize(tets_.size(), 0);
+  const std::uint64_t kIn = 2 * ++cavity_generation_, kDropped = kIn + 1;
+  auto taken = [&](Index x) { return cavity_mark_[static_cast<std::size_t>(x)] >= kIn; };  // in or dropped
+  auto inside = [&](Index x) { return cavity_mark_[static_cast<std::size_t>(x)] == kIn; };
+  auto take = [&](Index x) { cavity_mark_[static_cast<std::size_t>(x)] = kIn; };
   std::vector<Index> cavity{t};
-  std::unordered_map<Index, char> in{{t, 1}};
+  take(t);
   if (must_contain >= 0 && must_contain != t) {
     cavity.push_back(must_contain);
-    in.emplace(must_contain, 1);
+    take(must_contain);
   }
   for (std::size_t i = 0; i < cavity.size() && static_cast<Index>(cavity.size()) < max_cavity; ++i)
     for (int k = 0; k < 4; ++k) {
       const Index n = neighbour(cavity[i], k);
-      if (n < 0 || in.count(n)) continue;
+      if (n < 0 || taken(n)) continue;
       const auto& r = tet(n);
       Vec3 c;
       double r2 = 0;
       if (!tet_circumsphere(point(r[0]), point(r[1]), point(r[2]), point(r[3]), &c, &r2)) continue;
       if (squared_distance(c, p) < r2) {
-        in.emplace(n, 1);
+        take(n);
         cavity.push_back(n);
       }
     }
@@ -811,10 +822,10 @@ InsertOutcome RefineMesh::insert_point(
       const auto q = tet(cavity[i]);
       for (int k = 0; k < 4 && cavity.size() < limit; ++k) {
         const Index n = neighbour(cavity[i], k);
-        if (n < 0 || in.count(n)) continue;
+        if (n < 0 || taken(n)) continue;
         if (orient3d(point(q[kOppositeFace[k][0]]), point(q[kOppositeFace[k][1]]), point(q[kOppositeFace[k][2]]), p) !=
             Sign::kPositive) {
-          in.emplace(n, 1);
+          take(n);
           cavity.push_back(n);
         }
       }
@@ -830,11 +841,11 @@ InsertOutcome RefineMesh::insert_point(
     faces.clear();
     std::vector<Index> drop;
     for (Index c : cavity) {
-      if (!in[c]) continue;
+      if (!inside(c)) continue;
       const auto q = tet(c);
       for (int k = 0; k < 4; ++k) {
         const Index n = neighbour(c, k);
-        if (n >= 0 && in.count(n) && in[n]) continue;
+        if (n >= 0 && inside(n)) continue;
         const BFace f{{q[kOppositeFace[k][0]], q[kOppositeFace[k][1]], q[kOppositeFace[k][2]]}, c};
         if (orient3d(point(f.v[0]), point(f.v[1]), point(f.v[2]), p) != Sign::kPositive) drop.push_back(c);
         faces.push_back(f);
@@ -843,12 +854,12 @@ InsertOutcome RefineMesh::insert_point(
     if (drop.empty()) break;
     for (Index c : drop) {
       if (c == t || c == must_contain) return InsertOutcome::kNoStarCavity;
-      in[c] = 0;
+      cavity_mark_[static_cast<std::size_t>(c)] = kDropped;
     }
   }
   std::vector<Index> kept;
   for (Index c : cavity)
-    if (in[c]) kept.push_back(c);
+    if (inside(c)) kept.push_back(c);
   // 4. No vertex may disappear; clearance.
   std::vector<Index> on_boundary;
   for (const BFace& f : faces) on_boundary.insert(on_boundary.end(), f.v.begin(), f.v.end());

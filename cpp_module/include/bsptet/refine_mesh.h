@@ -271,6 +271,10 @@ class RefineMesh {
   std::unordered_map<FaceKey, Index, FaceKeyHash> boundary_;  ///< sorted face -> parent triangle
   Index alive_tets_ = 0;
   Index first_added_point_ = 0;
+  /// insert_point's cavity membership per tet slot: 2 g (in the cavity of call g), 2 g + 1 (taken
+  /// in, then dropped), anything else (not in it); g counts the calls.
+  std::vector<std::uint64_t> cavity_mark_;
+  std::uint64_t cavity_generation_ = 0;
 };
 
 }  // namespace bsptet
