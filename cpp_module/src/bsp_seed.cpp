@@ -698,6 +698,11 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     for (std::size_t s = 0; s < slots.size(); ++s) num_faces += s == 0 || slots[s].key != slots[s - 1].key;
     faces_.reserve(faces_.size() + num_faces + num_faces / 8);
     cells_.reserve(static_cast<std::size_t>(nt) + static_cast<std::size_t>(nt) / 8);
+    // Edges of a tetrahedralization: about points + tets (Euler), so the edge maps never rehash
+    // while the seed's faces register theirs.
+    const std::size_t num_edges = static_cast<std::size_t>(corner0_ + 8) + static_cast<std::size_t>(nt);
+    edge_faces_.reserve(edge_faces_.size() + num_edges + num_edges / 8);
+    edge_line_.reserve(edge_line_.size() + num_edges + num_edges / 8);
   }
   cells_.assign(static_cast<std::size_t>(nt), BspCell{});
   std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1}), nb(nt, {-1, -1, -1, -1});
@@ -711,7 +716,10 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
         if (q >= input_planes) continue;
         bool on = true;
         for (Index o : {x, y, z})
-          if (o != w && !geo_.known_on_plane(o, q) && geo_.side(q, o) != Sign::kZero) on = false;
+          if (o != w && !geo_.known_on_plane(o, q) && geo_.side(q, o) != Sign::kZero) {
+            on = false;
+            break;
+          }
         if (on) return q;
       }
     }
