@@ -562,6 +562,7 @@ Sign ImplicitGeometry::lifted_det2(Index a, Index b, Index c, Index d, int axis)
                  : lifted_det2_uncertain(m.data(), r.data(), m[3], r[3], axis, s)) &&
           s != Sign::kZero)
         return s;
+      if (exact && lifted_det2_filter_extended(m[0], m[1], m[2], m[3], axis, s) && s != Sign::kZero) return s;
     }
   }
   int s0 = 0;

@@ -17,10 +17,18 @@ constexpr double kOrient3dBound = 8.0 * kUnitRoundoff;
 constexpr double kOrient2dBound = 4.0 * kUnitRoundoff;
 // The lifted determinants below have depth 10 (det4) and 9 (det3) in rounded operations (the
 // coordinate differences included); the standard bound gamma_n * permanent, with the permanent
-// itself rounded over at most 10 operations, stays under 11u; 16u leaves room.
-constexpr double kLiftedBound = 16.0 * kUnitRoundoff;
+// itself rounded over at most 10 operations, stays under 11u; 16u leaves room (kLiftedBoundUnits;
+// u is the unit roundoff of the type they are evaluated in: double, or x87 extended).
+constexpr double kLiftedBoundUnits = 16.0;
 // Below this magnitude products may have underflowed and the relative bound no longer holds.
 constexpr double kUnderflowGuard = 1e-280;
+
+// True when long double has its 64-bit significand at run time (the extended filters' bounds
+// need it: x87 precision control lowered by other code, or valgrind's emulation, lose it).
+bool extended_precision_works() {
+  volatile long double one = 1.0L;
+  return one + 0x1p-63L != one;
+}
 
 Sign sign_of(double v) { return v > 0 ? Sign::kPositive : (v < 0 ? Sign::kNegative : Sign::kZero); }
 Sign sign_of(int v) { return v > 0 ? Sign::kPositive : (v < 0 ? Sign::kNegative : Sign::kZero); }
@@ -366,7 +374,7 @@ bool lifted_det3_filter_in(const Vec3& a, const Vec3& b, const Vec3& c, const Ve
   const T det = ((l[1] * d023 - l[0] * d123) + l[3] * d012) - l[2] * d013;
   const T perm = ((l[1] * q023 + l[0] * q123) + l[3] * q012) + l[2] * q013;
   using std::isfinite;
-  if (!(isfinite(perm) && perm > T(kUnderflowGuard) && fabs(det) > 16 * unit * perm)) return false;
+  if (!(isfinite(perm) && perm > T(kUnderflowGuard) && fabs(det) > T(kLiftedBoundUnits) * unit * perm)) return false;
   out = det > 0 ? Sign::kPositive : (det < 0 ? Sign::kNegative : Sign::kZero);
   return true;
 }
@@ -382,29 +390,44 @@ bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, co
   // The bound needs the 64-bit significand at run time too: code that lowers the x87 precision
   // control (or an emulator such as valgrind, which computes long double in double) would make
   // it unsound. Then decline (the caller decides exactly).
-  volatile long double one = 1.0L;
-  if (one + 0x1p-63L == one) return false;
+  if (!extended_precision_works()) return false;
   return lifted_det3_filter_in<long double>(a, b, c, d, e, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
                                             out);
 }
 
-bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {
+namespace {
+// lifted_det2_filter in the floating-point type T with unit roundoff `unit` (see
+// lifted_det3_filter_in: depth 9, the same bound).
+template <typename T>
+bool lifted_det2_filter_in(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, T unit, Sign& out) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const Vec3* rows[3] = {&a, &b, &c};
-  double r[3][3];
+  T r[3][3];
   for (int i = 0; i < 3; ++i) {
-    const double dx = rows[i]->x - d.x, dy = rows[i]->y - d.y, dz = rows[i]->z - d.z;
-    const double dd[3] = {dx, dy, dz};
+    const T dx = T(rows[i]->x) - T(d.x), dy = T(rows[i]->y) - T(d.y), dz = T(rows[i]->z) - T(d.z);
+    const T dd[3] = {dx, dy, dz};
     r[i][0] = dd[u], r[i][1] = dd[v], r[i][2] = dx * dx + dy * dy + dz * dz;
   }
+  using std::fabs;
   auto m = [&](int i, int j, int p, int q) { return r[i][p] * r[j][q] - r[i][q] * r[j][p]; };
-  auto pm = [&](int i, int j, int p, int q) { return std::fabs(r[i][p] * r[j][q]) + std::fabs(r[i][q] * r[j][p]); };
-  const double det = (r[0][0] * m(1, 2, 1, 2) - r[0][1] * m(1, 2, 0, 2)) + r[0][2] * m(1, 2, 0, 1);
-  const double perm = (std::fabs(r[0][0]) * pm(1, 2, 1, 2) + std::fabs(r[0][1]) * pm(1, 2, 0, 2)) +
-                      std::fabs(r[0][2]) * pm(1, 2, 0, 1);
-  if (!(std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > kLiftedBound * perm)) return false;
-  out = sign_of(det);
+  auto pm = [&](int i, int j, int p, int q) { return fabs(r[i][p] * r[j][q]) + fabs(r[i][q] * r[j][p]); };
+  const T det = (r[0][0] * m(1, 2, 1, 2) - r[0][1] * m(1, 2, 0, 2)) + r[0][2] * m(1, 2, 0, 1);
+  const T perm = (fabs(r[0][0]) * pm(1, 2, 1, 2) + fabs(r[0][1]) * pm(1, 2, 0, 2)) + fabs(r[0][2]) * pm(1, 2, 0, 1);
+  using std::isfinite;
+  if (!(isfinite(perm) && perm > T(kUnderflowGuard) && fabs(det) > T(kLiftedBoundUnits) * unit * perm)) return false;
+  out = det > 0 ? Sign::kPositive : (det < 0 ? Sign::kNegative : Sign::kZero);
   return true;
+}
+}  // namespace
+
+bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {
+  return lifted_det2_filter_in<double>(a, b, c, d, axis, kUnitRoundoff, out);
+}
+
+bool lifted_det2_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {
+  if (!extended_precision_works()) return false;
+  return lifted_det2_filter_in<long double>(a, b, c, d, axis, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
+                                            out);
 }
 
 Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int axis) {

@@ -232,6 +232,7 @@ TEST(LiftedFilters, AgreeWithExact) {
     const int axis = it % 3;
     const int ex2 = exact_lifted_det2(p, p[3], axis);
     if (lifted_det2_filter(p[0], p[1], p[2], p[3], axis, f)) ASSERT_EQ(static_cast<int>(f), ex2) << "it " << it;
+    if (lifted_det2_filter_extended(p[0], p[1], p[2], p[3], axis, f)) ASSERT_EQ(static_cast<int>(f), ex2) << "it " << it;
   }
   std::printf("lifted_det3: %d of %d certified, %d exact zeros\n", certified, trials, zeros);
   EXPECT_GT(zeros, 1000);           // the degenerate cases were really made
@@ -279,6 +280,31 @@ TEST(LiftedFilters, ExtendedPrecisionDecidesRoundedSpheres) {
   std::printf("certified: double %d, extended %d, of %d nonzero\n", by_double, by_extended, nonzero);
   EXPECT_LT(by_double, nonzero / 2);
   EXPECT_GT(by_extended, nonzero * 8 / 10);
+  // The in-circle test on a plane: four points rounded onto one circle of a plane z = c (a CAD
+  // plane's round hole), the fourth sometimes moved off it by a relative 1e-12.
+  int by_double2 = 0, by_extended2 = 0, nonzero2 = 0;
+  for (int it = 0; it < 20000; ++it) {
+    const double s = std::ldexp(1.0, scale_exp(rng)), cx = (it % 3 == 0) ? 50.0 : 0.0, r = 1 + U(rng) * 0.5;
+    Vec3 p[4];
+    for (int i = 0; i < 4; ++i) {
+      const double t = angle(rng), rr = (i == 3 && it % 2) ? r * (1 + 1e-12 * U(rng)) : r;
+      p[i] = {(cx + rr * std::cos(t)) * s, rr * std::sin(t) * s, 0.75 * s};
+    }
+    const int want = exact_lifted_det2(p, p[3], 2);
+    nonzero2 += want != 0;
+    Sign f;
+    if (lifted_det2_filter(p[0], p[1], p[2], p[3], 2, f)) {
+      ++by_double2;
+      ASSERT_EQ(static_cast<int>(f), want) << "it " << it;
+    }
+    if (lifted_det2_filter_extended(p[0], p[1], p[2], p[3], 2, f)) {
+      ++by_extended2;
+      ASSERT_EQ(static_cast<int>(f), want) << "it " << it;
+    }
+  }
+  std::printf("in-circle certified: double %d, extended %d, of %d nonzero\n", by_double2, by_extended2, nonzero2);
+  EXPECT_LT(by_double2, nonzero2 * 7 / 10);  // about half
+  EXPECT_GT(by_extended2, nonzero2 * 8 / 10);
 }
 
 // The filters for approximately known points: the exact points p are doubles (so the exact sign

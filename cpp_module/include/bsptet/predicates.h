@@ -57,6 +57,9 @@ bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 /// of the exact computation's cost.
 bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e,
                                  Sign& out);
+/// lifted_det2_filter in x87 extended precision (points rounded onto one circle: a CAD plane's
+/// round holes).
+bool lifted_det2_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out);
 /// The same determinants (unperturbed) for approximately known points, as orient3d_uncertain:
 /// p[0..3] (lifted_det3; p[0..2] for lifted_det2) within rp[i] of the exact points, e (the last
 /// row: e for lifted_det3, d for lifted_det2) within re.
