@@ -26,6 +26,7 @@ constexpr double kUnderflowGuard = 1e-280;
 // True when long double has its 64-bit significand at run time (the extended filters' bounds
 // need it: x87 precision control lowered by other code, or valgrind's emulation, lose it).
 bool extended_precision_works() {
+  if (std::numeric_limits<long double>::digits < 64) return false;
   volatile long double one = 1.0L;
   return one + 0x1p-63L != one;
 }
@@ -386,10 +387,10 @@ bool lifted_det3_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 
 bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e,
                                  Sign& out) {
-  static_assert(std::numeric_limits<long double>::digits >= 64, "needs x87 extended precision (64-bit significand)");
-  // The bound needs the 64-bit significand at run time too: code that lowers the x87 precision
+  // Where long double is double (MSVC, Apple arm64) the filter would repeat the double one:
+  // decline. At run time the significand must be there too: code that lowers the x87 precision
   // control (or an emulator such as valgrind, which computes long double in double) would make
-  // it unsound. Then decline (the caller decides exactly).
+  // the bound unsound. Then decline (the caller decides exactly).
   if (!extended_precision_works()) return false;
   return lifted_det3_filter_in<long double>(a, b, c, d, e, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
                                             out);
