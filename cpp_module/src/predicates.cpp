@@ -23,6 +23,9 @@ constexpr double kLiftedBoundUnits = 16.0;
 // Below this magnitude products may have underflowed and the relative bound no longer holds.
 constexpr double kUnderflowGuard = 1e-280;
 
+// Unit roundoff of the extended filters: 2^-64, that of a 64-bit significand (x87); for a wider
+// long double (quad) it is larger than the true one, so the bound stays sound.
+constexpr long double kExtendedUnitRoundoff = 0x1p-64L;
 // True when long double has its 64-bit significand at run time (the extended filters' bounds
 // need it: x87 precision control lowered by other code, or valgrind's emulation, lose it).
 bool extended_precision_works() {
@@ -392,8 +395,7 @@ bool lifted_det3_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, co
   // control (or an emulator such as valgrind, which computes long double in double) would make
   // the bound unsound. Then decline (the caller decides exactly).
   if (!extended_precision_works()) return false;
-  return lifted_det3_filter_in<long double>(a, b, c, d, e, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
-                                            out);
+  return lifted_det3_filter_in<long double>(a, b, c, d, e, kExtendedUnitRoundoff, out);
 }
 
 namespace {
@@ -427,8 +429,7 @@ bool lifted_det2_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 
 bool lifted_det2_filter_extended(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int axis, Sign& out) {
   if (!extended_precision_works()) return false;
-  return lifted_det2_filter_in<long double>(a, b, c, d, axis, std::ldexp(1.0L, -std::numeric_limits<long double>::digits),
-                                            out);
+  return lifted_det2_filter_in<long double>(a, b, c, d, axis, kExtendedUnitRoundoff, out);
 }
 
 Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int axis) {

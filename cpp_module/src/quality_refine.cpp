@@ -859,6 +859,7 @@ class Refiner {
   // One interior point that improves tet t (see insert_pass); false when no candidate does.
   bool insert_for(Index t) {
     constexpr auto& kFace = kTetOppositeFace;  // types.h
+    const bool curved = curved_tet10();       // the pre-session-16 pass there (see curved_tet10)
     {
       const auto q = m_.tet(t);
       Vec3 P[4];
@@ -871,7 +872,7 @@ class Refiner {
         FaceFrame fr;
         if (face_frame(P[kFace[k][0]], P[kFace[k][1]], P[kFace[k][2]], P[k], &fr))
           for (double f : {1.0, 0.5, 0.25})
-            if (f == 1.0 || !curved_tet10()) cand.push_back(fr.apex(f));
+            if (f == 1.0 || !curved) cand.push_back(fr.apex(f));
       }
       Vec3 cc;
       double r2 = 0;
@@ -880,14 +881,13 @@ class Refiner {
                       (P[0].z + P[1].z + P[2].z + P[3].z) / 4});
       // Local: a global floor (h / 8) kept points away from input surfaces finer than it
       // (triceratops: surface edges 0.1 h, every cap's candidate refused).
-      const double clearance = curved_tet10() ? std::max(floor_, 0.25 * mean) : 0.25 * mean;
+      const double clearance = curved ? std::max(floor_, 0.25 * mean) : 0.25 * mean;
       for (const Vec3& x : cand) {
         if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) continue;
         Index p = -1;
         // The cavity is capped at 64 tets: larger ones hardly ever improved a tet, and the failed
         // attempts were most of the pass's time (anchor: the same mesh as with 256, 15% faster).
-        const bool force = !curved_tet10();
-        if (m_.insert_point(t, x, clearance, &p, force ? 64 : 256, true, {}, force ? t : -1) != InsertOutcome::kInserted)
+        if (m_.insert_point(t, x, clearance, &p, curved ? 256 : 64, true, {}, curved ? -1 : t) != InsertOutcome::kInserted)
           continue;
         ++st_.insertions;
         double tg = 0;
@@ -1003,9 +1003,9 @@ class Refiner {
   // Curved tet10 through a projection hook (FreeCAD's tet10). Its insertion and sliver passes
   // stay as they were before session 16 (no forced tet, one height, the h / 8 clearance floor,
   // sliver splits not held to the worst angle; only insert_point's walk is the new one): the
-  // curving stage after them needs the room those left over curved faces. With session 16's passes 9 of the 13 CAD corpus files meshed at tet10
-  // instead of 10 (featuretype.STEP and bottle.brep stopped with inverted curved elements,
-  // SampleCrankshaft4A meshed).
+  // curving stage after them needs the room those left over curved faces. With session 16's
+  // passes 9 of the 13 CAD corpus files meshed at tet10 instead of 10 (featuretype.STEP and
+  // bottle.brep stopped with inverted curved elements, SampleCrankshaft4A meshed).
   bool curved_tet10() const { return o_.order == 2 && static_cast<bool>(o_.projection); }
 
   // Runs f, adding its wall time to st_.seconds_by_pass[pass]; returns f's result.

@@ -6,7 +6,6 @@
 #include <map>
 #include <set>
 #include <string>
-#include <unordered_map>
 
 #include "bsptet/errors.h"
 #include "bsptet/predicates.h"
@@ -696,9 +695,8 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
       best[static_cast<std::size_t>(i * n + j)] = c < 0 ? kNone : b;
       choice[static_cast<std::size_t>(i * n + j)] = c;
     }
-  const double got = best[static_cast<std::size_t>(n - 1)];
-  if (got <= kNone) return false;
-  if (!accept && got <= old_min + kImprovement) return false;
+  // (Without `accept`, a result is better than the shell by construction: floor_q above.)
+  if (best[static_cast<std::size_t>(n - 1)] <= kNone) return false;
   std::vector<std::array<Index, 4>> created;
   std::vector<std::pair<int, int>> todo{{0, n - 1}};
   while (!todo.empty()) {
