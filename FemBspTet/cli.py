@@ -1,7 +1,7 @@
 """The ``fembsptet`` command line.
 
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]
-                   [--min-dihedral D] [--surface-points exact|rounded] [--order 1|2]
+                   [--min-dihedral D] [--thickness-ratio K] [--surface-points exact|rounded] [--order 1|2]
                    [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
                    [--max-memory SIZE] [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
@@ -133,6 +133,8 @@ def _check_mesh_args(args):
         value = getattr(args, name, None)
         if value is not None and not (value > 0 and math.isfinite(value)):
             raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {value}")
+    if args.thickness_ratio is not None and not (args.thickness_ratio >= 0 and math.isfinite(args.thickness_ratio)):
+        raise InputError(f"--thickness-ratio must be 0 (off) or a positive number, got {args.thickness_ratio}")
     if args.timeout is not None and not (args.timeout > 0 and math.isfinite(args.timeout)):
         raise InputError(f"--timeout must be a positive number of seconds, got {args.timeout}")
     if args.write_intersections is not None:
@@ -227,6 +229,7 @@ def _cmd_mesh(args):
                      "min_size": args.min_size,
                      "radius_edge": args.radius_edge,
                      "min_dihedral": args.min_dihedral,
+                     "thickness_ratio": args.thickness_ratio,
                      "surface_points": args.surface_points,
                      "order": args.order,
                      "allow_boundary_steiner": args.allow_boundary_steiner,
@@ -426,6 +429,9 @@ def build_parser():
                    help="refine tets whose circumradius / shortest edge exceeds this (e.g. 2)")
     m.add_argument("--min-dihedral", type=float, default=None,
                    help="optimize until the smallest dihedral angle reaches this (degrees)")
+    m.add_argument("--thickness-ratio", type=float, default=None, metavar="K",
+                   help="thin walls: the size at a surface point is at most K times the solid's "
+                        "local thickness there (default 4; 0: off)")
     m.add_argument("--surface-points", choices=("exact", "rounded"), default=None,
                    help="exact (default): new surface points exactly on the input facets, none "
                         "where no double lies on them; rounded: rounded midpoints everywhere "

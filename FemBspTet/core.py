@@ -351,6 +351,9 @@ REFINE_OPTIONS = {
     "size_from_surface": "True: the size at each input triangle is at most its mean edge length "
                          "(the volume grades from a surface already meshed to size, as Gmsh's "
                          "MeshSizeExtendFromBoundary)",
+    "thickness_ratio": "thin walls: the size at a surface point is at most this times the solid's "
+                       "local thickness there (distance to the nearest opposing face inside; "
+                       "default 4; 0: off)",
     "radius_edge": "refine tets whose circumradius / shortest edge exceeds this (0 or None: off)",
     "min_dihedral": "the optimization stops once the smallest dihedral angle reaches this (deg)",
     "surface_points": "'exact' (default): new surface points exactly on the input facets, else "
@@ -412,6 +415,10 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     order = int(options.get("order") or 1)
     if order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}")
+    extra = {}  # absent: the core's defaults (quality_refine.h)
+    if options.get("thickness_ratio") is not None:
+        extra["thickness_ratio"] = _positive_number("thickness_ratio", options["thickness_ratio"],
+                                                    allow_zero=True)
     mode = options.get("surface_points") or "exact"
     if mode not in ("exact", "rounded"):
         raise InputError(f"surface_points must be 'exact' or 'rounded', got {mode!r}")
@@ -419,7 +426,7 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     if projection is not None and not callable(projection):
         raise InputError("projection must be a callable (point, tag, other_tag) -> point")
     only_order = (set(k for k, v in options.items() if v is not None)
-                  <= {"order", "projection", "separate_face_tags"})
+                  <= {"order", "projection", "separate_face_tags", "thickness_ratio"})
     native = _native()
     with _core_errors(surface, "refinement"):
         points, tets, st = native.refine(
@@ -429,7 +436,7 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
             projection=projection, max_passes=0 if only_order else 40, optimize_rounds=8,
             separate_face_tags=bool(options.get("separate_face_tags")),
             size_from_surface=bool(options.get("size_from_surface")), progress=progress,
-            cancel=cancel)
+            cancel=cancel, **extra)
     out = TetMesh(points, tets, mesh.source)
     exact = mode == "exact" and projection is None
     reference = surface if exact else boundary_surface(out)

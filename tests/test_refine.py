@@ -308,6 +308,27 @@ def test_bad_refinement_options_are_input_errors():
         core.tetrahedralize(surface, options={"radius_edge": 0.5})
     with pytest.raises(InputError, match="unknown"):
         core.tetrahedralize(surface, options={"sizes": 1.0})
+    with pytest.raises(InputError, match="thickness_ratio"):
+        core.tetrahedralize(surface, options={"size": 1.0, "thickness_ratio": -2})
+
+
+def test_thin_wall_sizing_refines_across_a_hollow_sphere():
+    """cray_left is a hollow sphere whose wall (254) is 1/17 of h = diagonal / 20: with the
+    default thickness_ratio (4) the edges on the wall come down to about 4 times its thickness and
+    the worst dihedral angle rises above TetGen's 5.74 degrees (-pq1.414a<V>); with
+    thickness_ratio 0 every tet spans the wall flat (about 2 degrees)."""
+    surface = read_surface(corpus_path("cray_left"))
+    h = diag(surface) / 20
+    opts = {"size": h, "surface_points": "rounded"}
+    flat, _ = core.tetrahedralize(surface, options=dict(opts, thickness_ratio=0))
+    walls, _ = core.tetrahedralize(surface, options=opts)
+    rf, rw = (core.check_mesh(core.boundary_surface(m), m) for m in (flat, walls))
+    print("worst angle %.2f (%d tets) -> %.2f (%d tets)" % (rf["quality"]["min_dihedral_deg"],
+          len(flat.tets), rw["quality"]["min_dihedral_deg"], len(walls.tets)))
+    assert rf["valid"] and rw["valid"]
+    assert rf["quality"]["min_dihedral_deg"] < 3
+    assert rw["quality"]["min_dihedral_deg"] > 5.74
+    assert np.median(edge_lengths(walls)) < 0.5 * np.median(edge_lengths(flat))
 
 
 def test_projection_check_names_what_moved_at_each_order():

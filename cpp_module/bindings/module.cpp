@@ -271,7 +271,7 @@ PYBIND11_MODULE(_bsptet, m) {
          std::map<std::int32_t, double> size_by_tag, double radius_edge, double min_dihedral, int order,
          const std::string& surface_points_mode, py::object projection, int max_passes, int optimize_rounds,
          bool separate_face_tags, bool size_from_surface, double split_ratio, double collapse_ratio,
-         py::object progress, py::object cancel) {
+         double thickness_ratio, py::object progress, py::object cancel) {
         SurfaceMesh s;
         s.xyz = points_from(surface_points, "surface_points");
         s.tri = indices_from(surface_triangles, "surface_triangles", 3);
@@ -295,6 +295,7 @@ PYBIND11_MODULE(_bsptet, m) {
         o.size_from_surface = size_from_surface;
         o.split_ratio = split_ratio;
         o.collapse_ratio = collapse_ratio;
+        o.thickness_ratio = thickness_ratio;
         if (surface_points_mode == "exact") o.surface_points = SurfacePoints::kExact;
         else if (surface_points_mode == "rounded") o.surface_points = SurfacePoints::kRounded;
         else throw py::value_error("surface_points must be 'exact' or 'rounded', got '" + surface_points_mode + "'");
@@ -346,7 +347,7 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("projection") = py::none(), py::arg("max_passes") = 40, py::arg("optimize_rounds") = 8,
       py::arg("separate_face_tags") = false, py::arg("size_from_surface") = false,
       py::arg("split_ratio") = RefineOptions{}.split_ratio, py::arg("collapse_ratio") = RefineOptions{}.collapse_ratio,
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      py::arg("thickness_ratio") = RefineOptions{}.thickness_ratio, py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       "Refines a valid tet mesh of a closed surface to a size and quality (see quality_refine.h). "
       "projection(point (3,), tag, other_tag) -> point moves new surface points. Returns (points, tets "
       "(m, 4) or (m, 10), stats dict).");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <queue>
 #include <string>
 #include <tuple>
@@ -14,6 +15,7 @@
 #include "bsptet/predicates.h"
 #include "bsptet/tet10.h"
 #include "bsptet/tet_shape.h"
+#include "bsptet/wall_thickness.h"
 
 namespace bsptet {
 
@@ -57,6 +59,8 @@ void check_options(const RefineOptions& o) {
   for (const auto& [tag, s] : o.size_by_tag)
     if (!(s > 0) || !std::isfinite(s))
       bad("the size of face tag " + std::to_string(tag) + " must be a positive length, got " + std::to_string(s));
+  if (!(o.thickness_ratio >= 0) || !std::isfinite(o.thickness_ratio))
+    bad("thickness_ratio must be 0 (off) or a positive number, got " + std::to_string(o.thickness_ratio));
   if (!(o.grading > 0)) bad("grading must be positive, got " + std::to_string(o.grading));
   if (!(o.collapse_ratio >= 0 && o.collapse_ratio < o.split_ratio))
     bad("collapse_ratio must be in [0, split_ratio), got " + std::to_string(o.collapse_ratio));
@@ -137,6 +141,8 @@ class Refiner {
         for (Index v : face) target_[static_cast<std::size_t>(v)] = std::min(target_[static_cast<std::size_t>(v)], mean);
       }
     }
+    if (floor_ == 0) compute_floor();
+    if (o_.thickness_ratio > 0) apply_wall_thickness();
     // Grading: t(v) <= t(u) + grading * |uv|.
     std::vector<std::vector<Index>> nbr(static_cast<std::size_t>(np));
     for (const auto& e : m_.edges()) {
@@ -174,28 +180,71 @@ class Refiner {
         t = std::max(t, e.reach - segment_distance(p, e.a, e.b));
       }
     }
-    if (floor_ == 0) {
-      double smallest = kInf;
-      for (Index v = 0; v < np; ++v)
-        if (!nbr[static_cast<std::size_t>(v)].empty()) smallest = std::min(smallest, target_[static_cast<std::size_t>(v)]);
-      if (o_.min_size > 0) {
-        floor_ = o_.min_size;
-      } else if (std::isfinite(smallest)) {
-        floor_ = smallest / 8;
-      } else {
-        double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-        for (Index v = 0; v < np; ++v) {
-          const Vec3& p = m_.point(v);
-          for (int c = 0; c < 3; ++c) {
-            lo[c] = std::min(lo[c], p[c]);
-            hi[c] = std::max(hi[c], p[c]);
-          }
+  }
+
+  // The smallest length refinement works at (RefineOptions::min_size), from the asked targets
+  // (size, size_by_tag, size_from_surface), once.
+  void compute_floor() {
+    const Index np = m_.num_points();
+    double smallest = kInf;
+    for (Index v = 0; v < np; ++v)
+      smallest = std::min(smallest, target_[static_cast<std::size_t>(v)]);
+    if (o_.min_size > 0) {
+      floor_ = o_.min_size;
+    } else if (std::isfinite(smallest)) {
+      floor_ = smallest / 8;
+    } else {
+      double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+      for (Index v = 0; v < np; ++v) {
+        const Vec3& p = m_.point(v);
+        for (int c = 0; c < 3; ++c) {
+          lo[c] = std::min(lo[c], p[c]);
+          hi[c] = std::max(hi[c], p[c]);
         }
-        floor_ = 1e-3 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
       }
+      floor_ = 1e-3 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                (hi[2] - lo[2]) * (hi[2] - lo[2]));
     }
   }
+
+  // RefineOptions::thickness_ratio: the target at a boundary point is at most thickness_ratio times
+  // the wall's thickness there (wall_thickness.h), measured against the input triangles with the
+  // point's normal the mean of its boundary faces' parents' normals; never below floor_.
+  void apply_wall_thickness() {
+    double largest = 0;
+    for (double t : target_)
+      if (std::isfinite(t)) largest = std::max(largest, t);
+    if (!(largest > floor_)) return;
+    const double reach = largest / o_.thickness_ratio;
+    if (!walls_ || walls_reach_ != reach) {
+      walls_ = std::make_unique<WallThickness>(m_.surface(), reach);
+      walls_reach_ = reach;
+    }
+    const Index np = m_.num_points();
+    std::vector<std::vector<Index>> own(static_cast<std::size_t>(np));
+    for (const auto& [face, parent] : m_.boundary_faces())
+      for (Index v : face) {
+        auto& list = own[static_cast<std::size_t>(v)];
+        if (std::find(list.begin(), list.end(), parent) == list.end()) list.push_back(parent);
+      }
+    for (Index v = 0; v < np; ++v) {
+      const auto& list = own[static_cast<std::size_t>(v)];
+      if (list.empty()) continue;
+      Vec3 n;
+      for (Index t : list) {
+        const Vec3& m = walls_->normal(t);
+        n = {n.x + m.x, n.y + m.y, n.z + m.z};
+      }
+      const double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+      if (!(len > 0)) continue;
+      n = {n.x / len, n.y / len, n.z / len};
+      const double thickness = walls_->at(m_.point(v), n, list);
+      if (!std::isfinite(thickness)) continue;
+      double& t = target_[static_cast<std::size_t>(v)];
+      t = std::min(t, std::max(o_.thickness_ratio * thickness, floor_));
+    }
+  }
+
   double target(Index v) const {
     return static_cast<std::size_t>(v) < target_.size() ? target_[static_cast<std::size_t>(v)] : o_.size;
   }
@@ -1028,6 +1077,8 @@ class Refiner {
   };
   std::vector<Stuck> stuck_;
   double floor_ = 0;
+  std::unique_ptr<WallThickness> walls_;  ///< thickness_ratio: the input's walls, built once
+  double walls_reach_ = 0;
   Index budget_ = 0;
   std::vector<std::uint64_t> flip_failed_at_, insert_failed_at_;  ///< see failed_before
   Index tets_after_size_ = 0;  ///< live tets after the first size phase (optimize_phase)

@@ -2,7 +2,9 @@
 // refused when invalid), the driver on real data, and the tet10 Jacobian.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <string>
@@ -11,9 +13,11 @@
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesh_io.h"
 #include "bsptet/mesher.h"
+#include "bsptet/predicates.h"
 #include "bsptet/quality_refine.h"
 #include "bsptet/refine_mesh.h"
 #include "bsptet/tet10.h"
+#include "bsptet/wall_thickness.h"
 
 using namespace bsptet;
 
@@ -470,4 +474,99 @@ TEST(QualityRefine, SeparateFaceTagsReportsWhatExactModeCannotMend) {
   EXPECT_GT(st.tag_splits, 0);
   EXPECT_EQ(st.tag_conflicts_left, left);
   EXPECT_LT(left, misread_tets(core, &b));
+}
+
+namespace {
+
+// The axis-aligned box [x0, x1] x [y0, y1] x [z0, z1] as 12 outward triangles, appended to s.
+void add_box(SurfaceMesh& s, double x0, double y0, double z0, double x1, double y1, double z1) {
+  const Index b = s.num_points();
+  for (int k = 0; k < 8; ++k) {
+    s.xyz.push_back(k & 1 ? x1 : x0);
+    s.xyz.push_back(k & 2 ? y1 : y0);
+    s.xyz.push_back(k & 4 ? z1 : z0);
+  }
+  // Outward quads (corner bits: 1 = x, 2 = y, 4 = z), counter-clockwise seen from outside.
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads)
+    for (int t : {q[0], q[1], q[2], q[0], q[2], q[3]}) s.tri.push_back(b + t);
+}
+
+std::vector<Index> triangles_on(const SurfaceMesh& s, int axis, double value) {
+  std::vector<Index> out;
+  for (Index t = 0; t < s.num_triangles(); ++t) {
+    bool all = true;
+    for (int k = 0; k < 3; ++k) all = all && s.point(s.tri[3 * t + k])[axis] == value;
+    if (all) out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace
+
+// The thickness of a plate on both faces and across its length; an opposing wall across air (a
+// second box above the plate) does not count; nothing beyond the reach.
+TEST(WallThickness, PlateFacesSeeTheirOppositeFaceNotTheGapAbove) {
+  SurfaceMesh s;
+  add_box(s, 0, 0, 0, 10, 10, 1);
+  add_box(s, 0, 0, 1.5, 10, 10, 2.5);
+  ASSERT_EQ(s.num_triangles(), 24);
+  for (Index t = 0; t < s.num_triangles(); ++t) {  // every triangle outward: its normal leaves its box
+    const Index box = t / 12;
+    const Vec3 c{5, 5, box == 0 ? 0.5 : 2.0};
+    EXPECT_EQ(orient3d(s.point(s.tri[3 * t]), s.point(s.tri[3 * t + 1]), s.point(s.tri[3 * t + 2]), c),
+              Sign::kNegative);
+  }
+  const WallThickness walls(s, 20);
+  const std::vector<Index> top = triangles_on(s, 2, 1.0), bottom = triangles_on(s, 2, 0.0),
+                           right = triangles_on(s, 0, 10.0);
+  EXPECT_DOUBLE_EQ(walls.at({5, 5, 1}, {0, 0, 1}, top), 1.0);       // not 0.5 (the gap above)
+  EXPECT_DOUBLE_EQ(walls.at({3, 7, 0}, {0, 0, -1}, bottom), 1.0);
+  EXPECT_DOUBLE_EQ(walls.at({2, 2, 2.5}, {0, 0, 1}, triangles_on(s, 2, 2.5)), 1.0);
+  // On x = 10 the plate's own face at x = 0 opposes (the second box's x = 0 face too, farther).
+  EXPECT_DOUBLE_EQ(walls.at({10, 5, 0.5}, {1, 0, 0}, right), 10.0);
+  EXPECT_TRUE(std::isinf(WallThickness(s, 5).at({10, 5, 0.5}, {1, 0, 0}, right)));
+  Vec3 q;
+  EXPECT_DOUBLE_EQ(point_triangle_squared_distance({3, -1, 4}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, &q), 4 + 1 + 16);
+  EXPECT_EQ(q.x, 1);
+}
+
+// A plate 40 x 40 x 2 refined to size 16 (8 times its thickness), rounded surface points: without
+// thickness sizing its tets span the wall flat (4.0 degrees); with thickness_ratio 2 the worst
+// angle is 7.3 (size 4 everywhere gives 9.6), and the mesh stays valid against its own boundary.
+TEST(QualityRefine, ThinWallSizingLiftsTheWorstAngleAcrossAPlate) {
+  SurfaceMesh s;
+  add_box(s, 0, 0, 0, 40, 40, 2);
+  const TetMesh core = tetrahedralize(s);
+  RefineOptions o;
+  o.size = 16;
+  o.surface_points = SurfacePoints::kRounded;
+  o.thickness_ratio = 0;
+  const TetMesh flat = refine_quality(s, core, o);
+  o.thickness_ratio = 2;
+  const TetMesh lifted = refine_quality(s, core, o);
+  auto own_boundary = [](const TetMesh& m) {
+    SurfaceMesh b;
+    b.xyz = m.xyz;
+    std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
+    for (Index t = 0; t < m.num_tets(); ++t) {
+      const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
+      const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+      for (const auto& f : outward) {
+        std::array<Index, 3> face{q[f[0]], q[f[1]], q[f[2]]}, key = face;
+        std::sort(key.begin(), key.end());
+        if (!faces.erase(key)) faces.emplace(key, face);
+      }
+    }
+    for (const auto& kv : faces) b.tri.insert(b.tri.end(), kv.second.begin(), kv.second.end());
+    return b;
+  };
+  const MeshCheckReport rf = check_mesh(own_boundary(flat), flat), rl = check_mesh(own_boundary(lifted), lifted);
+  ASSERT_TRUE(rf.valid);
+  ASSERT_TRUE(rl.valid);
+  EXPECT_GT(rl.quality.min_dihedral_deg, rf.quality.min_dihedral_deg + 2.5);  // 4.0 -> 7.3
+  EXPECT_GT(rl.quality.min_dihedral_deg, 7);
+  EXPECT_GT(lifted.num_tets(), flat.num_tets());
+  std::printf("plate 40x40x2 at size 16: worst angle %.2f (%d tets) without, %.2f (%d tets) with ratio 2\n",
+              rf.quality.min_dihedral_deg, flat.num_tets(), rl.quality.min_dihedral_deg, lifted.num_tets());
 }

@@ -3,7 +3,7 @@
 // exactly and prints one line of figures.
 //
 //   bsptet_refine SURFACE.off [--size H | --size-diag N] [--min-size L] [--radius-edge B]
-//                 [--min-dihedral D] [--split-ratio R] [--collapse-ratio C] [--optimize-rounds N]
+//                 [--min-dihedral D] [--split-ratio R] [--thickness-ratio K] [--collapse-ratio C] [--optimize-rounds N]
 //                 [--max-passes N] [--rounded] [--write STEM]
 //
 // --size-diag N sets H to the bounding-box diagonal / N. Exit: 0 valid, 1 error or invalid, 2 bad input.
@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--radius-edge")) o.radius_edge_bound = value();
     else if (!std::strcmp(argv[i], "--min-dihedral")) o.min_dihedral_deg = value();
     else if (!std::strcmp(argv[i], "--split-ratio")) o.split_ratio = value();
+    else if (!std::strcmp(argv[i], "--thickness-ratio")) o.thickness_ratio = value();
     else if (!std::strcmp(argv[i], "--collapse-ratio")) o.collapse_ratio = value();
     else if (!std::strcmp(argv[i], "--optimize-rounds")) o.optimize_rounds = static_cast<int>(value());
     else if (!std::strcmp(argv[i], "--max-passes")) o.max_passes = static_cast<int>(value());

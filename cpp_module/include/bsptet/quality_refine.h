@@ -60,6 +60,12 @@ struct RefineOptions {
   /// is already meshed to size (a remeshed CAD surface) instead of meeting small surface
   /// triangles with tets of `size`, which are flat there.
   bool size_from_surface = false;
+  /// Thin walls: the target at a surface point is at most thickness_ratio times the solid's local
+  /// thickness there (the distance across the solid to the nearest opposing input triangle,
+  /// wall_thickness.h), never below the floor (min_size). Tets of the asked size across a wall
+  /// much thinner than it are flat whatever the optimization does (a hollow sphere whose wall is
+  /// 1/17 of h: worst angle 2 degrees; at 4 times the thickness, 7.5). 0: off.
+  double thickness_ratio = 4;
   /// How fast the target grows away from smaller sizes: at most `grading` per unit length.
   double grading = 0.5;
   /// An edge is split when longer than split_ratio * target (1.0 would make `size` a strict
