@@ -179,6 +179,7 @@ def _mesh_on_cad(args, progress):
     file: boundary Steiner points and tet10 mid-nodes on the CAD faces. Returns (mesh, stats,
     notes)."""
     unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
+                                            ("--thickness-ratio", args.thickness_ratio),
                                             ("--surface-points", args.surface_points),
                                             ("--steiner-effort", args.steiner_effort),
                                             ("--bsp-seed", args.bsp_seed),

@@ -202,7 +202,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
     refining = any(options.get(k) is not None for k in REFINE_OPTIONS
-                   if k not in ("order", "projection", "separate_face_tags"))
+                   if k not in ("order", "projection", "separate_face_tags", "thickness_ratio"))
     separating = bool(options.get("separate_face_tags"))
     native = _native()
     checked, flipped = [], 0

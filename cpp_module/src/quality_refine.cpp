@@ -209,17 +209,14 @@ class Refiner {
 
   // RefineOptions::thickness_ratio: the target at a boundary point is at most thickness_ratio times
   // the wall's thickness there (wall_thickness.h), measured against the input triangles with the
-  // point's normal the mean of its boundary faces' parents' normals; never below floor_.
+  // point's normal the mean of its boundary faces' parents' normals; never below floor_. Walls
+  // are looked for only up to min(target, twice the longest edge of the point's input triangles)
+  // / thickness_ratio away: a wall thicker than the input's own triangles around the point is
+  // crossed by tets no longer than those triangles, not flat ones (and the search stays local on
+  // a fine tessellation meshed at a coarse size). Points without a finite target are left.
   void apply_wall_thickness() {
-    double largest = 0;
-    for (double t : target_)
-      if (std::isfinite(t)) largest = std::max(largest, t);
-    if (!(largest > floor_)) return;
-    const double reach = largest / o_.thickness_ratio;
-    if (!walls_ || walls_reach_ != reach) {
-      walls_ = std::make_unique<WallThickness>(m_.surface(), reach);
-      walls_reach_ = reach;
-    }
+    if (!walls_) walls_ = std::make_unique<WallThickness>(m_.surface());
+    const SurfaceMesh& in = m_.surface();
     const Index np = m_.num_points();
     std::vector<std::vector<Index>> own(static_cast<std::size_t>(np));
     for (const auto& [face, parent] : m_.boundary_faces())
@@ -229,19 +226,22 @@ class Refiner {
       }
     for (Index v = 0; v < np; ++v) {
       const auto& list = own[static_cast<std::size_t>(v)];
-      if (list.empty()) continue;
+      double& t = target_[static_cast<std::size_t>(v)];
+      if (list.empty() || !std::isfinite(t)) continue;
       Vec3 n;
-      for (Index t : list) {
-        const Vec3& m = walls_->normal(t);
+      double longest = 0;
+      for (Index tri : list) {
+        const Vec3& m = walls_->normal(tri);
         n = {n.x + m.x, n.y + m.y, n.z + m.z};
+        for (int k = 0; k < 3; ++k)
+          longest = std::max(longest, squared_distance(in.point(in.tri[3 * tri + k]), in.point(in.tri[3 * tri + (k + 1) % 3])));
       }
       const double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
       if (!(len > 0)) continue;
       n = {n.x / len, n.y / len, n.z / len};
-      const double thickness = walls_->at(m_.point(v), n, list);
-      if (!std::isfinite(thickness)) continue;
-      double& t = target_[static_cast<std::size_t>(v)];
-      t = std::min(t, std::max(o_.thickness_ratio * thickness, floor_));
+      const double reach = std::min(t, 2 * std::sqrt(longest)) / o_.thickness_ratio;
+      const double thickness = walls_->at(m_.point(v), n, list, reach);
+      if (std::isfinite(thickness)) t = std::min(t, std::max(o_.thickness_ratio * thickness, floor_));
     }
   }
 
@@ -1078,7 +1078,6 @@ class Refiner {
   std::vector<Stuck> stuck_;
   double floor_ = 0;
   std::unique_ptr<WallThickness> walls_;  ///< thickness_ratio: the input's walls, built once
-  double walls_reach_ = 0;
   Index budget_ = 0;
   std::vector<std::uint64_t> flip_failed_at_, insert_failed_at_;  ///< see failed_before
   Index tets_after_size_ = 0;  ///< live tets after the first size phase (optimize_phase)

@@ -58,51 +58,72 @@ double point_triangle_squared_distance(const Vec3& p, const Vec3& a, const Vec3&
   return dot(d, d);
 }
 
-WallThickness::WallThickness(const SurfaceMesh& surface, double reach) : s_(surface), reach_(reach) {
+WallThickness::WallThickness(const SurfaceMesh& surface) : s_(surface) {
   const Index nt = surface.num_triangles();
   normal_.resize(static_cast<std::size_t>(nt));
+  centroid_.resize(static_cast<std::size_t>(nt));
   seen_.assign(static_cast<std::size_t>(nt), 0);
-  double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                  std::numeric_limits<double>::infinity()};
-  double hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (Index i = 0; i < surface.num_points(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      lo[c] = std::min(lo[c], surface.point(i)[c]);
-      hi[c] = std::max(hi[c], surface.point(i)[c]);
-    }
-  double widest = 0;
-  for (int c = 0; c < 3; ++c) widest = std::max(widest, hi[c] - lo[c]);
-  if (!(widest > 0)) widest = 1;
-  cell_ = std::max(reach_, widest / 256);
-  for (int c = 0; c < 3; ++c) {
-    origin_[c] = lo[c];
-    dims_[c] = static_cast<std::int64_t>((hi[c] - lo[c]) / cell_) + 1;
-  }
   for (Index t = 0; t < nt; ++t) {
     const Vec3 a = surface.point(surface.tri[3 * t]), b = surface.point(surface.tri[3 * t + 1]),
                c = surface.point(surface.tri[3 * t + 2]);
     const Vec3 u = sub(b, a), v = sub(c, a);
-    Vec3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    const Vec3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
     const double len = std::sqrt(dot(n, n));
-    normal_[static_cast<std::size_t>(t)] = len > 0 ? Vec3{n.x / len, n.y / len, n.z / len} : Vec3{};
-    std::int64_t from[3], to[3];
-    for (int k = 0; k < 3; ++k) {
-      const double mn = std::min({a[k], b[k], c[k]}), mx = std::max({a[k], b[k], c[k]});
-      from[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((mn - origin_[k]) / cell_), 0, dims_[k] - 1);
-      to[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>((mx - origin_[k]) / cell_), 0, dims_[k] - 1);
-    }
-    for (std::int64_t i = from[0]; i <= to[0]; ++i)
-      for (std::int64_t j = from[1]; j <= to[1]; ++j)
-        for (std::int64_t k = from[2]; k <= to[2]; ++k) cells_[cell_key(i, j, k)].push_back(t);
+    centroid_[static_cast<std::size_t>(t)] = {(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, (a.z + b.z + c.z) / 3};
+    if (!(len > 0) || !std::isfinite(len)) continue;  // never opposes anything: left out
+    normal_[static_cast<std::size_t>(t)] = {n.x / len, n.y / len, n.z / len};
+    tris_.push_back(t);
+  }
+  if (!tris_.empty()) {
+    nodes_.reserve(2 * tris_.size());
+    build(0, static_cast<Index>(tris_.size()));
   }
 }
 
-std::int64_t WallThickness::cell_key(std::int64_t i, std::int64_t j, std::int64_t k) const {
-  return (i * dims_[1] + j) * dims_[2] + k;
+// Node over tris_[first, first + count): its box, then (more than 4 triangles) the two halves by
+// the median centroid along the box's longest axis (ties broken by triangle index: deterministic).
+Index WallThickness::build(Index first, Index count) {
+  const Index id = static_cast<Index>(nodes_.size());
+  nodes_.push_back(Node{});
+  Node nd;
+  for (int k = 0; k < 3; ++k) {
+    nd.lo[k] = std::numeric_limits<double>::infinity();
+    nd.hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (Index i = first; i < first + count; ++i) {
+    const Index t = tris_[static_cast<std::size_t>(i)];
+    for (int c = 0; c < 3; ++c) {
+      const Vec3 q = s_.point(s_.tri[3 * t + c]);
+      for (int k = 0; k < 3; ++k) {
+        nd.lo[k] = std::min(nd.lo[k], q[k]);
+        nd.hi[k] = std::max(nd.hi[k], q[k]);
+      }
+    }
+  }
+  nd.first = first;
+  nd.count = count;
+  nd.left = nd.right = -1;
+  if (count > 4) {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (nd.hi[k] - nd.lo[k] > nd.hi[axis] - nd.lo[axis]) axis = k;
+    const Index half = count / 2;
+    auto begin = tris_.begin() + first;
+    std::nth_element(begin, begin + half, begin + count, [&](Index a, Index b) {
+      const double ca = centroid_[static_cast<std::size_t>(a)][axis], cb = centroid_[static_cast<std::size_t>(b)][axis];
+      return ca < cb || (ca == cb && a < b);
+    });
+    nd.count = -1;
+    nd.left = build(first, half);
+    nd.right = build(first + half, count - half);
+  }
+  nodes_[static_cast<std::size_t>(id)] = nd;
+  return id;
 }
 
-double WallThickness::at(const Vec3& p, const Vec3& n, const std::vector<Index>& own) const {
-  double best2 = reach_ * reach_;
+double WallThickness::at(const Vec3& p, const Vec3& n, const std::vector<Index>& own, double reach) const {
+  if (nodes_.empty() || !(reach > 0)) return std::numeric_limits<double>::infinity();
+  double best2 = reach * reach;  // infinite reach: every triangle is looked at
   bool found = false;
   if (++stamp_ == 0) {
     std::fill(seen_.begin(), seen_.end(), 0);
@@ -110,34 +131,47 @@ double WallThickness::at(const Vec3& p, const Vec3& n, const std::vector<Index>&
   }
   for (Index t : own)
     if (t >= 0 && static_cast<std::size_t>(t) < seen_.size()) seen_[static_cast<std::size_t>(t)] = stamp_;
-  std::int64_t from[3], to[3];
-  for (int k = 0; k < 3; ++k) {
-    from[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((p[k] - reach_ - origin_[k]) / cell_)), 0,
-                                       dims_[k] - 1);
-    to[k] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((p[k] + reach_ - origin_[k]) / cell_)), 0,
-                                     dims_[k] - 1);
-  }
-  for (std::int64_t i = from[0]; i <= to[0]; ++i)
-    for (std::int64_t j = from[1]; j <= to[1]; ++j)
-      for (std::int64_t k = from[2]; k <= to[2]; ++k) {
-        const auto it = cells_.find(cell_key(i, j, k));
-        if (it == cells_.end()) continue;
-        for (Index t : it->second) {
-          std::uint32_t& mark = seen_[static_cast<std::size_t>(t)];
-          if (mark == stamp_) continue;
-          mark = stamp_;
-          const Vec3& m = normal_[static_cast<std::size_t>(t)];
-          if (!(dot(m, n) < -0.5)) continue;
-          Vec3 q;
-          const double d2 = point_triangle_squared_distance(p, s_.point(s_.tri[3 * t]), s_.point(s_.tri[3 * t + 1]),
-                                                            s_.point(s_.tri[3 * t + 2]), &q);
-          if (!(d2 > 0) || d2 >= best2) continue;
-          const Vec3 pq = sub(q, p);
-          if (!(dot(pq, n) < 0) || !(dot(pq, m) > 0)) continue;
-          best2 = d2;
-          found = true;
-        }
+  auto box_distance2 = [&](const Node& nd) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = p[k] < nd.lo[k] ? nd.lo[k] - p[k] : (p[k] > nd.hi[k] ? p[k] - nd.hi[k] : 0);
+      d2 += d * d;
+    }
+    return d2;
+  };
+  std::vector<Index> stack{0};
+  while (!stack.empty()) {
+    const Node& nd = nodes_[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    if (!(box_distance2(nd) < best2)) continue;
+    if (nd.count < 0) {
+      // Nearer child last (visited first), so the bound tightens early.
+      const Node& l = nodes_[static_cast<std::size_t>(nd.left)];
+      const Node& r = nodes_[static_cast<std::size_t>(nd.right)];
+      if (box_distance2(l) < box_distance2(r)) {
+        stack.push_back(nd.right);
+        stack.push_back(nd.left);
+      } else {
+        stack.push_back(nd.left);
+        stack.push_back(nd.right);
       }
+      continue;
+    }
+    for (Index i = nd.first; i < nd.first + nd.count; ++i) {
+      const Index t = tris_[static_cast<std::size_t>(i)];
+      if (seen_[static_cast<std::size_t>(t)] == stamp_) continue;
+      const Vec3& m = normal_[static_cast<std::size_t>(t)];
+      if (!(dot(m, n) < -0.5)) continue;
+      Vec3 q;
+      const double d2 = point_triangle_squared_distance(p, s_.point(s_.tri[3 * t]), s_.point(s_.tri[3 * t + 1]),
+                                                        s_.point(s_.tri[3 * t + 2]), &q);
+      if (!(d2 > 0) || !(d2 < best2)) continue;
+      const Vec3 pq = sub(q, p);
+      if (!(dot(pq, n) < 0) || !(dot(pq, m) > 0)) continue;
+      best2 = d2;
+      found = true;
+    }
+  }
   return found ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
 }
 

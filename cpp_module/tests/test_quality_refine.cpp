@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -517,18 +518,87 @@ TEST(WallThickness, PlateFacesSeeTheirOppositeFaceNotTheGapAbove) {
     EXPECT_EQ(orient3d(s.point(s.tri[3 * t]), s.point(s.tri[3 * t + 1]), s.point(s.tri[3 * t + 2]), c),
               Sign::kNegative);
   }
-  const WallThickness walls(s, 20);
+  const WallThickness walls(s);
   const std::vector<Index> top = triangles_on(s, 2, 1.0), bottom = triangles_on(s, 2, 0.0),
                            right = triangles_on(s, 0, 10.0);
-  EXPECT_DOUBLE_EQ(walls.at({5, 5, 1}, {0, 0, 1}, top), 1.0);       // not 0.5 (the gap above)
-  EXPECT_DOUBLE_EQ(walls.at({3, 7, 0}, {0, 0, -1}, bottom), 1.0);
-  EXPECT_DOUBLE_EQ(walls.at({2, 2, 2.5}, {0, 0, 1}, triangles_on(s, 2, 2.5)), 1.0);
+  EXPECT_DOUBLE_EQ(walls.at({5, 5, 1}, {0, 0, 1}, top, 20), 1.0);  // not 0.5 (the gap above)
+  EXPECT_DOUBLE_EQ(walls.at({3, 7, 0}, {0, 0, -1}, bottom, 20), 1.0);
+  EXPECT_DOUBLE_EQ(walls.at({2, 2, 2.5}, {0, 0, 1}, triangles_on(s, 2, 2.5), 20), 1.0);
   // On x = 10 the plate's own face at x = 0 opposes (the second box's x = 0 face too, farther).
-  EXPECT_DOUBLE_EQ(walls.at({10, 5, 0.5}, {1, 0, 0}, right), 10.0);
-  EXPECT_TRUE(std::isinf(WallThickness(s, 5).at({10, 5, 0.5}, {1, 0, 0}, right)));
-  Vec3 q;
-  EXPECT_DOUBLE_EQ(point_triangle_squared_distance({3, -1, 4}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, &q), 4 + 1 + 16);
-  EXPECT_EQ(q.x, 1);
+  EXPECT_DOUBLE_EQ(walls.at({10, 5, 0.5}, {1, 0, 0}, right, 20), 10.0);
+  EXPECT_TRUE(std::isinf(walls.at({10, 5, 0.5}, {1, 0, 0}, right, 5)));
+  // Its own triangles are skipped: without them, a corner point's own faces at distance 0 do
+  // not count either (distance 0), so the answer is the same.
+  EXPECT_DOUBLE_EQ(walls.at({10, 0, 1}, {0, 0, 1}, {}, 20), 1.0);
+}
+
+// Every region of the nearest-point computation (3 corners, 3 edges, the inside), against the
+// answer worked out by hand.
+TEST(WallThickness, NearestPointOnATriangleInEveryRegion) {
+  const Vec3 a{0, 0, 0}, b{4, 0, 0}, c{0, 4, 0};
+  const struct {
+    Vec3 p, q;
+  } cases[] = {{{-1, -1, 2}, {0, 0, 0}}, {{6, -1, 1}, {4, 0, 0}},  {{-1, 7, 0}, {0, 4, 0}},
+               {{2, -3, 1}, {2, 0, 0}},  {{-2, 1, 5}, {0, 1, 0}},  {{3, 3, -1}, {2, 2, 0}},
+               {{1, 1, 3}, {1, 1, 0}}};
+  for (const auto& k : cases) {
+    Vec3 q;
+    const double d2 = point_triangle_squared_distance(k.p, a, b, c, &q);
+    EXPECT_NEAR(q.x, k.q.x, 1e-12);
+    EXPECT_NEAR(q.y, k.q.y, 1e-12);
+    EXPECT_NEAR(q.z, k.q.z, 1e-12);
+    const double e2 = (k.p.x - k.q.x) * (k.p.x - k.q.x) + (k.p.y - k.q.y) * (k.p.y - k.q.y) + (k.p.z - k.q.z) * (k.p.z - k.q.z);
+    EXPECT_NEAR(d2, e2, 1e-12);
+  }
+}
+
+// The tree's pruned search gives what a scan of every triangle gives, on a random soup of
+// triangles of very different sizes, for reaches from tiny to unbounded.
+TEST(WallThickness, TreeSearchAgreesWithAScanOfEveryTriangle) {
+  SurfaceMesh s;
+  std::uint64_t state = 12345;
+  auto rnd = [&]() {  // deterministic, in [0, 1)
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int t = 0; t < 600; ++t) {
+    const double scale = t % 10 == 0 ? 5.0 : 0.3;
+    const Vec3 o{10 * rnd(), 10 * rnd(), 10 * rnd()};
+    for (int k = 0; k < 3; ++k) {
+      s.xyz.push_back(o.x + scale * (rnd() - 0.5));
+      s.xyz.push_back(o.y + scale * (rnd() - 0.5));
+      s.xyz.push_back(o.z + scale * (rnd() - 0.5));
+      s.tri.push_back(3 * t + k);
+    }
+  }
+  const WallThickness walls(s);
+  int found = 0;
+  for (int q = 0; q < 300; ++q) {
+    const Vec3 p{10 * rnd(), 10 * rnd(), 10 * rnd()};
+    Vec3 n{rnd() - 0.5, rnd() - 0.5, rnd() - 0.5};
+    const double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+    n = {n.x / len, n.y / len, n.z / len};
+    for (double reach : {0.2, 1.0, 3.0, std::numeric_limits<double>::infinity()}) {
+      double best = std::numeric_limits<double>::infinity();
+      for (Index t = 0; t < s.num_triangles(); ++t) {
+        const Vec3& m = walls.normal(t);
+        if (!(m.x * n.x + m.y * n.y + m.z * n.z < -0.5)) continue;
+        Vec3 c;
+        const double d = std::sqrt(point_triangle_squared_distance(p, s.point(3 * t), s.point(3 * t + 1), s.point(3 * t + 2), &c));
+        const Vec3 pq{c.x - p.x, c.y - p.y, c.z - p.z};
+        if (d > 0 && d < reach && pq.x * n.x + pq.y * n.y + pq.z * n.z < 0 && pq.x * m.x + pq.y * m.y + pq.z * m.z > 0)
+          best = std::min(best, d);
+      }
+      const double got = walls.at(p, n, {}, reach);
+      if (std::isinf(best)) {
+        EXPECT_TRUE(std::isinf(got)) << "query " << q << " reach " << reach;
+      } else {
+        ++found;
+        EXPECT_NEAR(got, best, 1e-12) << "query " << q << " reach " << reach;
+      }
+    }
+  }
+  EXPECT_GT(found, 300);
 }
 
 // A plate 40 x 40 x 2 refined to size 16 (8 times its thickness), rounded surface points: without

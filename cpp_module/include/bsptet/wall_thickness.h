@@ -1,7 +1,7 @@
 // FemBspTet quality stage, sizing: the local thickness of a solid's wall at a point of its surface.
 //
-//   WallThickness walls(surface, reach);
-//   double t = walls.at(p, outward_normal, own_triangles);
+//   WallThickness walls(surface);
+//   double t = walls.at(p, outward_normal, own_triangles, reach);
 //
 // The thickness at a surface point p with outward unit normal n is the distance from p to the
 // nearest input triangle f that faces p from across the solid: f's outward unit normal m opposes
@@ -10,18 +10,19 @@
 // plate of thickness t gives t on both faces; the gap of a slot (air between two facing walls)
 // does not count (q lies outward of p); neighbouring triangles of a smooth surface do not count
 // (their normals are close to n). Triangles listed in `own` (those p lies on) are skipped. Only
-// triangles within `reach` of p are looked at: the answer is infinity when none qualifies there.
+// triangles nearer than `reach` are looked at: the answer is infinity when none qualifies there.
 //
 // A sizing heuristic in doubles (no topological decision depends on it): the quality stage lowers
 // its target size across thin walls to a multiple of this (RefineOptions::thickness_ratio), where
 // tets of the asked size would span the wall flat.
 //
-// Lookups go through a uniform grid of cells at least `reach` wide (at most 256 per axis of the
-// bounding box), so a query visits at most 8 cells. Deterministic.
+// Lookups descend a bounding-box tree over the triangles (median splits, a few triangles per
+// leaf), skipping boxes farther than the best distance found so far: a query costs about the
+// number of triangles within `reach`, whatever the spread of triangle sizes. Degenerate triangles
+// (zero normal) are left out. Deterministic; a query is not thread-safe (it marks `own`).
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "bsptet/types.h"
@@ -30,26 +31,28 @@ namespace bsptet {
 
 class WallThickness {
  public:
-  /// `surface`: closed, outward oriented (types.h). `reach` > 0 and finite: the largest thickness
-  /// of interest.
-  WallThickness(const SurfaceMesh& surface, double reach);
+  /// `surface`: closed, outward oriented (types.h).
+  explicit WallThickness(const SurfaceMesh& surface);
 
   /// Thickness at point p (on the surface) with outward unit normal n, skipping the triangles in
-  /// `own` (sorted or not; small). Infinity when no opposing triangle is within reach.
-  double at(const Vec3& p, const Vec3& n, const std::vector<Index>& own) const;
+  /// `own` (small). Infinity when no opposing triangle is nearer than `reach`.
+  double at(const Vec3& p, const Vec3& n, const std::vector<Index>& own, double reach) const;
 
   /// Unit outward normal of input triangle t (zero for a degenerate triangle).
   const Vec3& normal(Index t) const { return normal_[static_cast<std::size_t>(t)]; }
 
  private:
-  std::int64_t cell_key(std::int64_t i, std::int64_t j, std::int64_t k) const;
+  struct Node {
+    double lo[3], hi[3];
+    Index first, count;  ///< leaf: tris_[first .. first + count); inner: count = -1, children
+    Index left, right;   ///< (inner nodes)
+  };
+  Index build(Index first, Index count);
   const SurfaceMesh& s_;
-  double reach_;
-  double origin_[3] = {0, 0, 0};
-  double cell_ = 1;
-  std::int64_t dims_[3] = {1, 1, 1};
   std::vector<Vec3> normal_;
-  std::unordered_map<std::int64_t, std::vector<Index>> cells_;
+  std::vector<Index> tris_;       ///< non-degenerate triangles, in tree order
+  std::vector<Vec3> centroid_;    ///< per input triangle
+  std::vector<Node> nodes_;
   mutable std::vector<std::uint32_t> seen_;
   mutable std::uint32_t stamp_ = 0;
 };
