@@ -179,7 +179,6 @@ def _mesh_on_cad(args, progress):
     file: boundary Steiner points and tet10 mid-nodes on the CAD faces. Returns (mesh, stats,
     notes)."""
     unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
-                                            ("--thickness-ratio", args.thickness_ratio),
                                             ("--surface-points", args.surface_points),
                                             ("--steiner-effort", args.steiner_effort),
                                             ("--bsp-seed", args.bsp_seed),
@@ -200,6 +199,8 @@ def _mesh_on_cad(args, progress):
                             order=args.order, quality_bound=args.radius_edge or 0.0,
                             allow_boundary_steiner=args.allow_boundary_steiner,
                             compare_tetgen=False)
+    if args.thickness_ratio is not None:
+        params.thickness_ratio = args.thickness_ratio
     result = mesh_cad_shape(shape, params, progress=lambda stage, fraction: progress(stage),
                             source=os.path.basename(args.input))
     return result.mesh, dict(result.stats), list(result.notes)

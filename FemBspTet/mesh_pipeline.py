@@ -63,6 +63,7 @@ CORE_OPTION_OF = {
     "max_size": "size",
     "min_size": "min_size",
     "quality_bound": "radius_edge",
+    "thickness_ratio": "thickness_ratio",
     "order": "order",
     "allow_boundary_steiner": "allow_boundary_steiner",
 }
@@ -77,6 +78,7 @@ PROPERTY_OF = {
     "linear_deflection": "LinearDeflection",
     "angular_deflection": "AngularDeflection",
     "quality_bound": "QualityBound",
+    "thickness_ratio": "ThicknessRatio",
     "allow_boundary_steiner": "AllowBoundarySteiner",
     "face_groups": "FaceGroups",
     "compare_tetgen": "CompareWithTetGen",
@@ -112,6 +114,8 @@ class MeshParameters:
     angular_deflection:     angle between neighbouring triangles' normals (OCCT default 0.5).
     quality_bound:          radius-edge ratio bound of quality refinement; 0 = no refinement.
                             Needs the quality stage (refused with a message otherwise).
+    thickness_ratio:        thin walls: the size on a face is at most this times the solid's
+                            local thickness there (the quality stage's thickness_ratio; 0 = off).
     allow_boundary_steiner: keep Steiner points on the surface (they are projected onto the CAD).
     face_groups:            one FemMesh node group per CAD face (``BspTet_Face<k>``).
     compare_tetgen:         also run ``tetgen -pY`` on the same surface and report its counts.
@@ -127,6 +131,7 @@ class MeshParameters:
     linear_deflection: float = 0.0
     angular_deflection: float = 0.5
     quality_bound: float = 0.0
+    thickness_ratio: float = 4.0
     allow_boundary_steiner: bool = False
     face_groups: bool = False
     compare_tetgen: bool = False
@@ -134,7 +139,8 @@ class MeshParameters:
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
-        for name in ("max_size", "min_size", "linear_deflection", "quality_bound"):
+        for name in ("max_size", "min_size", "linear_deflection", "quality_bound",
+                     "thickness_ratio"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise InputError("%s must be a finite number >= 0 (0 = automatic/off), got %r"
@@ -277,6 +283,7 @@ def core_options(params, projection=None):
         value = getattr(params, field)
         if value > 0:
             opts[CORE_OPTION_OF[field]] = float(value)
+    opts[CORE_OPTION_OF["thickness_ratio"]] = float(params.thickness_ratio)  # 0 turns it off
     if projection is not None:
         opts[CORE_PROJECTION_OPTION] = projection
     return opts

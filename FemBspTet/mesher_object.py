@@ -46,6 +46,9 @@ PARAMETER_PROPERTIES = (
     ("App::PropertyFloat", "QualityBound", PARAMS_GROUP,
      "Radius-edge ratio bound of quality refinement (0 = off; e.g. 1.414). Needs the core's "
      "quality stage", 0.0),
+    ("App::PropertyFloat", "ThicknessRatio", PARAMS_GROUP,
+     "Thin walls: the element size on a face is at most this times the solid's local thickness "
+     "there (0 = off). Tets of the full size across a much thinner wall are flat", 4.0),
     ("App::PropertyBool", "AllowBoundarySteiner", PARAMS_GROUP,
      "Allow Steiner points on the surface (placed on the CAD faces)", False),
     ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,

@@ -28,6 +28,7 @@ def parameters_from_object(obj):
         linear_deflection=float(obj.LinearDeflection.Value),
         angular_deflection=math.radians(float(obj.AngularDeflection.Value)),
         quality_bound=float(obj.QualityBound),
+        thickness_ratio=float(getattr(obj, "ThicknessRatio", 4.0)),
         allow_boundary_steiner=bool(obj.AllowBoundarySteiner),
         face_groups=bool(obj.FaceGroups),
         compare_tetgen=bool(obj.CompareWithTetGen),
@@ -126,7 +127,7 @@ def mesh_shape(shape, **options):
 
     options: MeshParameters fields (``max_size``, ``min_size``, ``order``,
     ``linear_deflection``, ``angular_deflection`` in radians, ``quality_bound``,
-    ``allow_boundary_steiner``, ``face_groups``) or the object's property names
+    ``thickness_ratio``, ``allow_boundary_steiner``, ``face_groups``) or the object's property names
     (``CharacteristicLengthMax``, ``ElementOrder`` "1st"/"2nd", ``AngularDeflection`` in
     degrees, ...). Raises InputError / InternalError with a message.
     """

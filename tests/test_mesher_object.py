@@ -240,7 +240,8 @@ def test_property_names_reach_the_core_under_its_option_names():
                            projection=hook)
     assert opts == {"size": 5.0, "min_size": 1.0, "radius_edge": 1.5, "order": 2,
                     "allow_boundary_steiner": False, "projection": hook,
-                    "separate_face_tags": True, "bsp_seed": "auto"}
+                    "separate_face_tags": True, "bsp_seed": "auto", "thickness_ratio": 4.0}
+    assert mp.core_options(mp.MeshParameters(thickness_ratio=0))["thickness_ratio"] == 0.0
     assert "min_size" not in mp.core_options(mp.MeshParameters(max_size=5))
 
 
@@ -268,6 +269,26 @@ def test_quality_bound_and_sizes_are_honoured(doc, fc):
         assert int((lengths > 2.0 * 4.0 * (1 + 1e-9)).sum()) <= left <= 0.01 * len(edges)
 
 
+def test_thickness_ratio_refines_a_thin_plate(doc, fc):
+    """ThicknessRatio: a 60 x 60 x 2 mm plate at CharacteristicLengthMax 12 (6 times its
+    thickness). Off, its tets span the wall flat; at the default 4 the faces are meshed at about
+    4 times the thickness: more tets, a better worst angle."""
+    _, Part, _ = fc
+    part = add_part(doc, fc, Part.makeBox(60, 60, 2))
+    worst = {}
+    counts = {}
+    for ratio in (0.0, 4.0):
+        obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False,
+                                    CharacteristicLengthMax=12.0, ThicknessRatio=ratio)
+        FemBspTet.run_mesher(obj)
+        worst[ratio], counts[ratio] = obj.MinDihedralAngle, obj.Tetrahedra
+        assert obj.FemMesh.VolumeCount == obj.Tetrahedra > 0
+    print("worst angle %.2f (%d tets) -> %.2f (%d tets)" % (worst[0.0], counts[0.0], worst[4.0],
+                                                            counts[4.0]))
+    assert counts[4.0] > 1.3 * counts[0.0]  # 576 -> 915 at 30d5e73
+    assert worst[4.0] > worst[0.0]
+
+
 def test_parameters_are_validated_with_property_names():
     with pytest.raises(InputError, match="CharacteristicLengthMax must be a finite number"):
         mp.MeshParameters(max_size=-1).validate()
@@ -275,6 +296,8 @@ def test_parameters_are_validated_with_property_names():
         mp.MeshParameters(max_size=1, min_size=2).validate()
     with pytest.raises(InputError, match="AngularDeflection"):
         mp.MeshParameters(angular_deflection=0).validate()
+    with pytest.raises(InputError, match="ThicknessRatio must be a finite number"):
+        mp.MeshParameters(thickness_ratio=-1).validate()
     with pytest.raises(InputError, match="unknown mesh parameter"):
         mp.MeshParameters.from_dict({"size": 3})
     p = mp.MeshParameters(max_size=5, order=1)
@@ -366,8 +389,9 @@ def test_save_and_reload(doc, fc, tmp_path):
         assert o2.Nodes == len(nodes) and o2.MeshStatus.startswith("meshed")
         # a restored object upgrades itself: a property missing in an old file comes back
         o2.removeProperty("QualityBound")
+        o2.removeProperty("ThicknessRatio")
         o2.Proxy.onDocumentRestored(o2)
-        assert o2.QualityBound == 0.0
+        assert o2.QualityBound == 0.0 and o2.ThicknessRatio == 4.0
     finally:
         freecad.closeDocument(d2.Name)
 
