@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <unordered_map>
@@ -698,6 +699,24 @@ MeshCheckReport check_mesh(const SurfaceMesh& surface, const TetMesh& mesh,
   if (options.compute_quality) r.quality = tet_quality(mesh);
   r.messages = msg.take();
   return r;
+}
+
+SurfaceMesh boundary_surface(const TetMesh& mesh) {
+  static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
+  for (Index t = 0; t < mesh.num_tets(); ++t) {
+    const Index* q = &mesh.tet[static_cast<std::size_t>(mesh.nodes_per_tet) * static_cast<std::size_t>(t)];
+    for (const auto& f : outward) {
+      std::array<Index, 3> face{q[f[0]], q[f[1]], q[f[2]]}, key = face;
+      std::sort(key.begin(), key.end());
+      if (!faces.erase(key)) faces.emplace(key, face);
+    }
+  }
+  SurfaceMesh out;
+  out.xyz = mesh.xyz;
+  out.tri.reserve(3 * faces.size());
+  for (const auto& kv : faces) out.tri.insert(out.tri.end(), kv.second.begin(), kv.second.end());
+  return out;
 }
 
 }  // namespace bsptet

@@ -393,22 +393,13 @@ SurfaceMesh tagged_prism() {
 // tag's boundary faces, or three that are not a boundary face of that tag. Tags are told by
 // place (caps at z = 0 and z = 30).
 int misread_tets(const TetMesh& m, SurfaceMesh* boundary) {
-  static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
-  for (Index t = 0; t < m.num_tets(); ++t) {
-    const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
-    for (const auto& o : outward) {
-      std::array<Index, 3> f{q[o[0]], q[o[1]], q[o[2]]}, key = f;
-      std::sort(key.begin(), key.end());
-      if (!faces.erase(key)) faces.emplace(key, f);
-    }
-  }
-  boundary->xyz = m.xyz;
-  boundary->tri.clear();
+  *boundary = boundary_surface(m);
   std::map<std::array<Index, 3>, int> tag_of_face;
   std::vector<std::set<int>> point_tags(static_cast<std::size_t>(m.num_points()));
-  for (const auto& [key, f] : faces) {
-    boundary->tri.insert(boundary->tri.end(), f.begin(), f.end());
+  for (Index b = 0; b < boundary->num_triangles(); ++b) {
+    const std::array<Index, 3> f{boundary->tri[3 * b], boundary->tri[3 * b + 1], boundary->tri[3 * b + 2]};
+    std::array<Index, 3> key = f;
+    std::sort(key.begin(), key.end());
     const double z0 = m.point(f[0]).z, z1 = m.point(f[1]).z, z2 = m.point(f[2]).z;
     const int tag = (z0 == 0 && z1 == 0 && z2 == 0) ? 2 : (z0 == 30 && z1 == 30 && z2 == 30) ? 1 : 0;
     tag_of_face[key] = tag;
@@ -615,23 +606,8 @@ TEST(QualityRefine, ThinWallSizingLiftsTheWorstAngleAcrossAPlate) {
   const TetMesh flat = refine_quality(s, core, o);
   o.thickness_ratio = 2;
   const TetMesh lifted = refine_quality(s, core, o);
-  auto own_boundary = [](const TetMesh& m) {
-    SurfaceMesh b;
-    b.xyz = m.xyz;
-    std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
-    for (Index t = 0; t < m.num_tets(); ++t) {
-      const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
-      const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-      for (const auto& f : outward) {
-        std::array<Index, 3> face{q[f[0]], q[f[1]], q[f[2]]}, key = face;
-        std::sort(key.begin(), key.end());
-        if (!faces.erase(key)) faces.emplace(key, face);
-      }
-    }
-    for (const auto& kv : faces) b.tri.insert(b.tri.end(), kv.second.begin(), kv.second.end());
-    return b;
-  };
-  const MeshCheckReport rf = check_mesh(own_boundary(flat), flat), rl = check_mesh(own_boundary(lifted), lifted);
+  const MeshCheckReport rf = check_mesh(boundary_surface(flat), flat),
+                        rl = check_mesh(boundary_surface(lifted), lifted);
   ASSERT_TRUE(rf.valid);
   ASSERT_TRUE(rl.valid);
   EXPECT_GT(rl.quality.min_dihedral_deg, rf.quality.min_dihedral_deg + 2.5);  // 4.0 -> 7.3

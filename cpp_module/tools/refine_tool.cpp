@@ -12,9 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
-#include <array>
-#include <map>
 #include <string>
 
 #include "bsptet/errors.h"
@@ -79,22 +76,7 @@ int main(int argc, char** argv) {
     RefineStats st;
     const TetMesh m = refine_quality(s, core, o, &st);
     // Rounded mode: the boundary is checked against itself (see refine_mesh.h).
-    SurfaceMesh reference = s;
-    if (o.surface_points == SurfacePoints::kRounded) {
-      reference.xyz = m.xyz;
-      reference.tri.clear();
-      std::map<std::array<Index, 3>, std::array<Index, 3>> faces;
-      for (Index t = 0; t < m.num_tets(); ++t) {
-        const Index* q = &m.tet[static_cast<std::size_t>(4 * t)];
-        const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-        for (const auto& f : outward) {
-          std::array<Index, 3> face{q[f[0]], q[f[1]], q[f[2]]}, key = face;
-          std::sort(key.begin(), key.end());
-          if (!faces.erase(key)) faces.emplace(key, face);
-        }
-      }
-      for (const auto& [key, face] : faces) reference.tri.insert(reference.tri.end(), face.begin(), face.end());
-    }
+    const SurfaceMesh reference = o.surface_points == SurfacePoints::kRounded ? boundary_surface(m) : s;
     const MeshCheckReport r = check_mesh(reference, m);
     std::printf("%s: %s h %.6g core tets %d min_dihedral %.2f -> tets %d points %d min_dihedral %.2f p1 %.2f "
                 "median %.2f max_radius_edge %.3g splits %lld (surface %lld, no exact point %lld, rejected %lld) "

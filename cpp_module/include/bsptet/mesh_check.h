@@ -71,4 +71,10 @@ struct MeshCheckReport {
 MeshCheckReport check_mesh(const SurfaceMesh& surface, const TetMesh& mesh,
                            const MeshCheckOptions& options = {});
 
+/// The boundary of a tet mesh (its first four nodes per tet) as a surface: the faces of exactly
+/// one tet, oriented outward (types.h), in the order of their sorted vertex triples; the points
+/// are the mesh's. What a mesh whose surface points are off the input (rounded mode, a projection
+/// hook) is checked against.
+SurfaceMesh boundary_surface(const TetMesh& mesh);
+
 }  // namespace bsptet

@@ -131,7 +131,7 @@ class RefineMesh {
   std::vector<std::array<Index, 2>> edges() const;
   /// Face tag of input triangle t (-1 when the surface has no tags).
   std::int32_t tag_of(Index tri) const;
-  /// Input triangles of the surface each point lies on (input points: every triangle around it).
+  /// The input surface the mesh refines.
   const SurfaceMesh& surface() const { return surface_; }
 
   // ---- Operations: each checked exactly, applied only when valid --------------------------------
