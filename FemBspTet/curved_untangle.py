@@ -176,3 +176,92 @@ def untangle_interior_midnodes(points, tets, bad, movable, rounds=40, cancel=Non
             break
     still_bad = bad[element_quality(bad) <= 0]
     return still_bad, np.array(sorted(moved), dtype=np.int64)
+
+
+#: :func:`straighten_midnodes`: the fractions of its way back to the CAD tried for each pulled
+#: mid-node, largest first (0 = on its chord, 1 = where it was).
+STRAIGHTEN_FRACTIONS = (0.875, 0.75, 0.625, 0.5, 0.375, 0.25, 0.125)
+
+
+def straighten_midnodes(points, tets, bad, cancel=None):
+    """The last resort for curved elements that stay inverted: pull mid-nodes onto their chords.
+
+    A tet10 element whose six mid-nodes are the midpoints of its edges is its straight tet, whose
+    Jacobian is constant and positive wherever the corners are positively oriented. So: every
+    mid-node of an element of ``bad`` that is off its chord goes to the chord's midpoint; every
+    element that this makes non-positive somewhere has its mid-nodes pulled too, until none is
+    left (at worst a whole region straight). Then each pulled node goes back towards where it
+    was, to the largest fraction of ``STRAIGHTEN_FRACTIONS`` that keeps every element containing
+    it at least half as good as it is on the chord (and above zero). Only mid-nodes move; a
+    boundary mid-node pulled off its CAD face stays on the tessellation's side of it, at most the
+    chord sag away.
+
+    points: (n, 3) float array, changed in place; tets: (m, 10) (corner order as
+    :func:`untangle_interior_midnodes`); bad: element indices; cancel: called now and then.
+
+    Returns ``(still_bad, pulled, off)``: the elements that are still not positive at a sample
+    (their corners are inverted: no mid-node can mend that), the pulled node indices (sorted)
+    and, for each, its distance from where it was.
+    """
+    bad = np.unique(np.asarray(bad, dtype=np.int64))
+    empty = np.zeros(0, dtype=np.int64)
+    if len(bad) == 0:
+        return bad, empty, np.zeros(0)
+    edges = np.array(_EDGES)
+    # owners of each mid-node, and its chord's midpoint
+    owners = {}
+    chord = {}
+    for k in range(6):
+        col = tets[:, 4 + k]
+        for e, m in enumerate(col.tolist()):
+            owners.setdefault(m, []).append(e)
+    _, scale = _scales(points, tets)
+
+    def mid_of(e, k):
+        return 0.5 * (points[tets[e, edges[k, 0]]] + points[tets[e, edges[k, 1]]])
+
+    def quality(elems):
+        elems = np.asarray(elems, dtype=np.int64)
+        return jacobians(points[tets[elems]]).min(axis=1) / scale[elems]
+
+    home = {}
+    pending = set(bad.tolist())
+    while pending:
+        if cancel is not None:
+            cancel()
+        pulled_now = []
+        for e in sorted(pending):
+            for k in range(6):
+                m = int(tets[e, 4 + k])
+                if m in home:
+                    continue
+                c = mid_of(e, k)
+                if np.array_equal(points[m], c):
+                    continue
+                home[m] = points[m].copy()
+                chord[m] = c
+                points[m] = c
+                pulled_now.append(m)
+        if not pulled_now:
+            break  # what is left has inverted corners
+        around = sorted({e for m in pulled_now for e in owners[m]} | pending)
+        q = quality(around)
+        pending = {e for e, v in zip(around, q.tolist()) if v <= 0}
+    pulled = np.array(sorted(home), dtype=np.int64)
+    for m in pulled.tolist():
+        if cancel is not None:
+            cancel()
+        elems = owners[m]
+        on_chord = quality(elems)
+        floor = np.where(on_chord > 0, 0.5 * on_chord, np.inf)
+        for frac in STRAIGHTEN_FRACTIONS:
+            points[m] = chord[m] + frac * (home[m] - chord[m])
+            if (quality(elems) >= floor).all():
+                break
+        else:
+            points[m] = chord[m]
+    touched = sorted({e for m in pulled.tolist() for e in owners[m]} | set(bad.tolist()))
+    q = quality(touched)
+    still_bad = np.array([e for e, v in zip(touched, q.tolist()) if v <= 0], dtype=np.int64)
+    off = np.array([float(np.linalg.norm(points[m] - home[m])) for m in pulled.tolist()])
+    return still_bad, pulled, off

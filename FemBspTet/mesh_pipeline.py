@@ -83,6 +83,7 @@ PROPERTY_OF = {
     "face_groups": "FaceGroups",
     "compare_tetgen": "CompareWithTetGen",
     "remesh_surface": "RemeshSurface",
+    "straighten_midnodes": "StraightenMidNodes",
 }
 
 #: Prefix of the FemMesh node group made for each CAD face (``BspTet_Face3``). FEM's CalculiX
@@ -123,6 +124,12 @@ class MeshParameters:
                             (:mod:`FemBspTet.surface_remesh`) before the volume mesh, and make
                             the volume to that size; off (default): the core fills
                             OpenCASCADE's tessellation as it is (README: what it gains, costs).
+    straighten_midnodes:    tet10: where curved mid-nodes still invert elements after every mend
+                            (and, without remesh_surface, a finer tessellation), pull them
+                            towards their straight edges (:func:`FemBspTet.curved_untangle.
+                            straighten_midnodes`) and say so in a note, instead of stopping with
+                            the error; a pulled boundary mid-node is off its CAD face by at most
+                            the chord sag, and getNodesByFace may miss it.
     """
 
     max_size: float = 0.0
@@ -136,6 +143,7 @@ class MeshParameters:
     face_groups: bool = False
     compare_tetgen: bool = False
     remesh_surface: bool = False
+    straighten_midnodes: bool = True
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -335,7 +343,9 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
     if not shape_is_brep_copy:
         shape = brep_copy(shape)
     try:
-        return _mesh_cad_shape_once(shape, params, progress, cancel, source)
+        # with RemeshSurface there is no finer-tessellation attempt: straighten at once
+        return _mesh_cad_shape_once(shape, params, progress, cancel, source,
+                                    straighten=params.remesh_surface)
     except CurvedElementsInverted as first:
         if params.order != 2 or params.remesh_surface:
             raise
@@ -350,11 +360,31 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         try:
             result = _mesh_cad_shape_once(shape, finer, again, cancel, source, repair_rounds=0)
         except CurvedElementsInverted as second:
-            raise CurvedElementsInverted(
+            both = CurvedElementsInverted(
                 first.summary, first.count,
                 "%s. A finer tessellation (AngularDeflection %.3g) was tried too: it inverted %d "
                 "element(s)" % (str(first)[len(first.summary):].rstrip("."),
-                                finer.angular_deflection, second.count)) from None
+                                finer.angular_deflection, second.count))
+            if not params.straighten_midnodes:
+                raise CurvedElementsInverted(
+                    both.summary, both.count,
+                    str(both)[len(both.summary):] + ". StraightenMidNodes (on by default) makes a "
+                    "valid mesh with their mid-nodes pulled towards their straight edges") \
+                    from None
+            # the attempt that inverted fewer, once more (the pipeline is deterministic), its
+            # inverted elements' mid-nodes pulled towards their chords
+            if first.count <= second.count:
+                retry, retry_report, rounds = params, report, None
+            else:
+                retry, retry_report, rounds = finer, again, 0
+            try:
+                result = _mesh_cad_shape_once(shape, retry, retry_report, cancel, source,
+                                              repair_rounds=rounds, straighten=True)
+            except CurvedElementsInverted:
+                raise both from None
+            if retry is finer:
+                result.stats["angular_deflection_used"] = float(finer.angular_deflection)
+            return result
         result.stats["angular_deflection_used"] = float(finer.angular_deflection)
         result.notes.append(
             "tet10: with AngularDeflection %.3g the curved mid-nodes inverted elements (%s); the "
@@ -363,11 +393,14 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", shape_i
         return result
 
 
-def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=None):
+def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=None,
+                         straighten=False):
     """One run of the pipeline on ``shape`` (a BREP copy) with validated ``params``.
     ``repair_rounds``: tet10 attempts on a mended surface after the first (None: the default,
-    ``LOCAL_REFINEMENT_ROUNDS`` with RemeshSurface, ``CURVED_REPAIR_ROUNDS`` without). The
-    rest as :func:`mesh_cad_shape`.
+    ``LOCAL_REFINEMENT_ROUNDS`` with RemeshSurface, ``CURVED_REPAIR_ROUNDS`` without).
+    ``straighten``: with ``params.straighten_midnodes``, tet10 elements still inverted after
+    every mend get their mid-nodes pulled towards their chords (:func:`straighten_inverted`)
+    instead of the error. The rest as :func:`mesh_cad_shape`.
     """
     from . import cad_tessellation, core
     from .cad_projection import CadProjection
@@ -484,6 +517,13 @@ def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=
         size_points = np.vstack([size_points, refinement_points(mesh, bad, params.min_size)])
     (attempt, surfaces, remesh_notes, remesh_stats, mesh, stats, faces, tags, midnodes, moved,
      max_move, kept, bad) = best
+    straightened = None
+    if len(bad) and straighten and params.straighten_midnodes and mesh.tets.shape[1] == 10:
+        report("pulling the mid-nodes of elements that stay inverted towards their chords", 0.89)
+        bad, straightened = straighten_inverted(mesh, midnodes, tags, bad, projection,
+                                                cancel=check_cancel)
+        stats = dict(stats)
+        stats["curved_repair"] = dict(stats.get("curved_repair", {}), **straightened)
     check_elements_after_projection(mesh, moved, faces, tags, shape_face_names(projection),
                                     stats.get("min_dihedral_deg"), bad=bad)
     if attempt and params.remesh_surface:
@@ -523,6 +563,20 @@ def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=
             "%d boundary node(s) stay off the CAD (up to %.3g mm, at %s): their place on the CAD "
             "edge is another node's (the mesh edge there is not along the CAD edge of its two "
             "faces), so getNodesByFace may miss them" % (len(kept), worst, ", ".join(faces_named)))
+    if straightened is not None and straightened["straightened_midnodes"]:
+        on_cad = straightened["straightened_boundary_midnodes"]
+        notes.append(
+            "tet10: curved mid-nodes inverted %d element(s) after every mend; %d mid-node(s) were "
+            "pulled towards their straight edges to keep every element valid%s. A finer "
+            "AngularDeflection or LinearDeflection, or ElementOrder 1st, keeps every boundary node "
+            "on the CAD" % (straightened["inverted_before_straightening"],
+                            straightened["straightened_midnodes"],
+                            "" if not on_cad else
+                            ", %d of them on the boundary, now up to %.3g mm off the CAD faces "
+                            "(%s): getNodesByFace may miss those"
+                            % (on_cad, straightened["max_off_cad_mm"],
+                               ", ".join(shape_face_names(projection)[t]
+                                         for t in straightened["faces"]))))
     if near:
         notes.append(
             "%d interior node(s) lie within the CAD face tolerance of a face (%s): FreeCAD's "
@@ -768,6 +822,33 @@ def slide_boundary_midnodes(mesh, faces, tags, midnodes, bad, projection, rounds
         if not changed or len(bad) == 0:
             break
     return bad, np.array(sorted(slid), dtype=np.int64)
+
+
+def straighten_inverted(mesh, midnodes, tags, bad, projection, cancel=None):
+    """:func:`FemBspTet.curved_untangle.straighten_midnodes` on the elements ``bad`` of a tet10
+    mesh (``mesh.points`` changed in place). Returns ``(still bad, stats)``; the stats say how
+    many elements were inverted, how many mid-nodes were pulled (boundary ones apart), how far
+    the pulled boundary ones are from their CAD faces at most (mm: from their places on the CAD,
+    ``projection.to_faces``), and on which CAD faces (``faces``, sorted tags; a boundary
+    mid-node belongs to the faces of the boundary triangles that share its edge)."""
+    from .curved_untangle import straighten_midnodes
+
+    count = int(len(bad))
+    still, pulled, _ = straighten_midnodes(mesh.points, mesh.tets, bad, cancel=cancel)
+    node_tags = {}
+    wanted = set(pulled.tolist())
+    for row, t in zip(np.asarray(midnodes).tolist(), tags.tolist()):
+        for m in wanted.intersection(row):
+            node_tags.setdefault(m, set()).add(int(t))
+    off = 0.0
+    for m, ts in sorted(node_tags.items()):
+        q = np.array(projection.to_faces(mesh.points[m], ts), dtype=np.float64)
+        off = max(off, float(np.linalg.norm(q - mesh.points[m])))
+    return still, {"inverted_before_straightening": count,
+                   "straightened_midnodes": int(len(pulled)),
+                   "straightened_boundary_midnodes": len(node_tags),
+                   "max_off_cad_mm": off,
+                   "faces": sorted(set().union(*node_tags.values())) if node_tags else []}
 
 
 def shape_face_names(projection):

@@ -59,6 +59,11 @@ PARAMETER_PROPERTIES = (
      "Remesh each CAD face's tessellation towards the element size (well-shaped triangles on "
      "the CAD faces, as Gmsh and Netgen do) before the volume mesh. Better shaped tets, "
      "slower, more tets", False),
+    ("App::PropertyBool", "StraightenMidNodes", PARAMS_GROUP,
+     "2nd order: where the curved mid-nodes still invert elements after every mend, pull them "
+     "towards their straight edges (a valid mesh; those boundary mid-nodes are then off the CAD "
+     "face by up to the chord sag, and a note says how many and how far) instead of stopping "
+     "with an error", True),
 )
 
 #: (type, name, tooltip) of every read-only result property.

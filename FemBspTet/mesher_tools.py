@@ -33,6 +33,7 @@ def parameters_from_object(obj):
         face_groups=bool(obj.FaceGroups),
         compare_tetgen=bool(obj.CompareWithTetGen),
         remesh_surface=bool(getattr(obj, "RemeshSurface", False)),
+        straighten_midnodes=bool(getattr(obj, "StraightenMidNodes", True)),
     ).validate()
 
 
@@ -127,7 +128,8 @@ def mesh_shape(shape, **options):
 
     options: MeshParameters fields (``max_size``, ``min_size``, ``order``,
     ``linear_deflection``, ``angular_deflection`` in radians, ``quality_bound``,
-    ``thickness_ratio``, ``allow_boundary_steiner``, ``face_groups``) or the object's property names
+    ``thickness_ratio``, ``allow_boundary_steiner``, ``face_groups``, ``remesh_surface``,
+    ``straighten_midnodes``) or the object's property names
     (``CharacteristicLengthMax``, ``ElementOrder`` "1st"/"2nd", ``AngularDeflection`` in
     degrees, ...). Raises InputError / InternalError with a message.
     """

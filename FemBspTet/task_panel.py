@@ -75,7 +75,14 @@ class TaskPanelMeshBspTet:
         self.ck_groups = QtGui.QCheckBox("Node group per CAD face")
         self.ck_tetgen = QtGui.QCheckBox("Compare with tetgen -pY")
         self.ck_remesh = QtGui.QCheckBox("Remesh the CAD faces to the element size")
-        for ck in (self.ck_boundary, self.ck_groups, self.ck_tetgen, self.ck_remesh):
+        self.ck_straighten = QtGui.QCheckBox("2nd order: straighten mid-nodes that would "
+                                             "invert elements")
+        self.ck_straighten.setToolTip(
+            "Where the curved mid-nodes still invert elements after every mend, pull them "
+            "towards their straight edges (a note says how many and how far off the CAD they "
+            "are) instead of stopping with an error")
+        for ck in (self.ck_boundary, self.ck_groups, self.ck_tetgen, self.ck_remesh,
+                   self.ck_straighten):
             grid.addRow(ck)
         layout.addWidget(params)
 
@@ -141,6 +148,7 @@ class TaskPanelMeshBspTet:
         self.ck_groups.setChecked(bool(o.FaceGroups))
         self.ck_tetgen.setChecked(bool(o.CompareWithTetGen))
         self.ck_remesh.setChecked(bool(getattr(o, "RemeshSurface", False)))
+        self.ck_straighten.setChecked(bool(getattr(o, "StraightenMidNodes", True)))
 
     def store_parameters(self):
         o = self.obj
@@ -157,6 +165,8 @@ class TaskPanelMeshBspTet:
         o.CompareWithTetGen = self.ck_tetgen.isChecked()
         if hasattr(o, "RemeshSurface"):
             o.RemeshSurface = self.ck_remesh.isChecked()
+        if hasattr(o, "StraightenMidNodes"):
+            o.StraightenMidNodes = self.ck_straighten.isChecked()
 
     # ---------------------------------------------------------------- task dialog API
 

@@ -95,3 +95,71 @@ def test_no_valid_neighbour_is_made_invalid():
     q = cu.jacobians(points[tets]).min(axis=1)
     assert q[1] > 0  # the valid neighbour stays valid
     assert len(still) == 0 and q[0] > 0
+
+
+def shared_pair(first, second, shared):
+    """Points and (2, 10) tets of two elements, ``shared`` {second's local index: first's}."""
+    points = np.vstack([first, second])
+    tets = np.array([np.arange(10), np.arange(10, 20)])
+    for k, v in shared.items():
+        tets[tets == 10 + k] = v
+    return points, tets
+
+
+def test_straightening_makes_a_folded_element_valid_and_pulls_back_as_little_as_it_can():
+    """The folded element of the tests above, its boundary mid-nodes (AB, CA) curved 0.22 into
+    it and no interior mid-node allowed to help: straighten_midnodes pulls them towards their
+    chords, only as far as needed (not all the way: the element is valid half way), and says how
+    far each moved. Corners never move."""
+    points = concave_face_element()
+    tets = np.arange(10)[None]
+    corners = points[:4].copy()
+    curved = points.copy()
+    assert cu.jacobians(points[tets]).min() < 0
+    still, pulled, off = cu.straighten_midnodes(points, tets, [0])
+    assert len(still) == 0
+    assert cu.jacobians(points[tets]).min() > 0
+    assert pulled.tolist() == [4, 6]  # the mid-nodes of AB and CA: the only ones off their chords
+    assert np.array_equal(points[:4], corners)
+    assert np.allclose(off, np.linalg.norm(points[pulled] - curved[pulled], axis=1))
+    assert (off > 0).all() and (off < 0.22).all()  # pulled part of the way, never past the chord
+    for m, (i, j) in zip(pulled.tolist(), (EDGES[0], EDGES[2])):
+        chord = 0.5 * (points[i] + points[j])
+        # still on the segment from the chord's midpoint to where it was
+        t = np.dot(points[m] - chord, curved[m] - chord) / np.dot(curved[m] - chord,
+                                                                    curved[m] - chord)
+        assert 0 <= t < 1
+        assert np.allclose(points[m], chord + t * (curved[m] - chord))
+
+
+def test_straightening_keeps_a_neighbour_sharing_a_pulled_mid_node_valid():
+    """A valid neighbour below face ABC shares corners A, B and the curved mid-node of AB with
+    the folded element: after the pull every element is positive everywhere, the neighbour
+    included, and the nodes that were on their chords stay exactly there."""
+    bad = concave_face_element()
+    a, b = bad[0], bad[1]
+    second = tet10([b, a, (0.5, -0.5, 0.0), (0.4, -0.1, -0.6)])
+    if cu.jacobians(second[None]).min() < 0:
+        second = tet10([a, b, (0.5, -0.5, 0.0), (0.4, -0.1, -0.6)])
+    second[4 + EDGES.index((0, 1))] = bad[4]  # the shared, curved mid-node of AB
+    assert cu.jacobians(second[None]).min() > 0
+    a_in, b_in = (1, 0) if np.array_equal(second[0], b) else (0, 1)
+    points, tets = shared_pair(bad, second, {a_in: 0, b_in: 1, 4 + EDGES.index((0, 1)): 4})
+    before = points.copy()
+    still, pulled, off = cu.straighten_midnodes(points, tets, [0])
+    assert len(still) == 0
+    assert (cu.jacobians(points[tets]).min(axis=1) > 0).all()
+    assert set(pulled.tolist()) <= {4, 6}
+    for n in set(np.unique(tets[:, 4:]).tolist()) - {4, 6}:
+        assert np.array_equal(points[n], before[n])
+
+
+def test_inverted_corners_stay_reported():
+    """An element whose corners are inverted cannot be mended by mid-nodes: it is returned as
+    still bad (and its straight mid-nodes are left alone)."""
+    points = tet10([(0, 0, 0), (0, 1, 0), (1, 0, 0), (0, 0, 1)])  # negative orientation
+    tets = np.arange(10)[None]
+    before = points.copy()
+    still, pulled, off = cu.straighten_midnodes(points, tets, [0])
+    assert still.tolist() == [0] and len(pulled) == 0
+    assert np.array_equal(points, before)

@@ -390,8 +390,10 @@ def test_save_and_reload(doc, fc, tmp_path):
         # a restored object upgrades itself: a property missing in an old file comes back
         o2.removeProperty("QualityBound")
         o2.removeProperty("ThicknessRatio")
+        o2.removeProperty("StraightenMidNodes")
         o2.Proxy.onDocumentRestored(o2)
         assert o2.QualityBound == 0.0 and o2.ThicknessRatio == 4.0
+        assert o2.StraightenMidNodes is True
     finally:
         freecad.closeDocument(d2.Name)
 

@@ -354,21 +354,59 @@ def test_tet10_falls_back_to_a_finer_tessellation_and_says_so(fc, monkeypatch):
             assert d <= max(face.Tolerance, 1e-7), (tag, n, d)
 
 
-def test_tet10_failing_also_when_finer_raises_the_first_attempts_message(fc, monkeypatch):
-    """Both attempts fail: the first attempt's message, with a sentence on the second."""
+def _spy_on_attempts(monkeypatch):
     monkeypatch.setattr(mesh_pipeline, "SLIDE_ROUNDS", 0)
     monkeypatch.setattr(mesh_pipeline, "CURVED_REPAIR_ROUNDS", 0)
     seen = []
     real = mesh_pipeline._mesh_cad_shape_once
 
     def spy(shape, params, *args, **kwargs):
-        seen.append(params.angular_deflection)
+        seen.append((params.angular_deflection, kwargs.get("straighten", False)))
         return real(shape, params, *args, **kwargs)
 
     monkeypatch.setattr(mesh_pipeline, "_mesh_cad_shape_once", spy)
+    return seen
+
+
+def test_tet10_failing_also_when_finer_raises_the_first_attempts_message(fc, monkeypatch):
+    """Both attempts fail and StraightenMidNodes is off: the first attempt's message, with a
+    sentence on the second."""
+    seen = _spy_on_attempts(monkeypatch)
     with pytest.raises(mesh_pipeline.CurvedElementsInverted, match="would invert") as err:
         mesh_pipeline.mesh_cad_shape(filleted_cylinder(fc, radius=20.0),
-                                     mesh_pipeline.MeshParameters(order=2))
-    assert seen == [0.5, 0.25]
+                                     mesh_pipeline.MeshParameters(order=2,
+                                                                  straighten_midnodes=False))
+    assert seen == [(0.5, False), (0.25, False)]
     assert "ElementOrder 1st" in str(err.value)
     assert "finer tessellation (AngularDeflection 0.25) was tried too" in str(err.value)
+    assert "StraightenMidNodes (on by default)" in str(err.value)
+
+
+def test_tet10_pulls_mid_nodes_towards_their_chords_when_every_attempt_inverts(fc, monkeypatch):
+    """The same shape with StraightenMidNodes on (the default): the attempt that inverted fewer
+    elements runs once more and pulls the mid-nodes of its inverted elements towards their
+    chords. The mesh is valid (every Jacobian sample positive); every boundary node is on its
+    CAD face within the face's tolerance except the pulled boundary mid-nodes, which are at most
+    the reported distance off (less than the tessellation's deflection); a note says so."""
+    freecad, Part, _ = fc
+    seen = _spy_on_attempts(monkeypatch)
+    shape = filleted_cylinder(fc, radius=20.0)
+    result = mesh_pipeline.mesh_cad_shape(shape, mesh_pipeline.MeshParameters(order=2))
+    assert seen[:2] == [(0.5, False), (0.25, False)] and seen[2][1] is True and len(seen) == 3
+    repair = result.stats["curved_repair"]
+    print("curved repair:", repair, result.notes)
+    assert repair["inverted_before_straightening"] > 0
+    assert repair["straightened_boundary_midnodes"] > 0
+    assert 0 < repair["max_off_cad_mm"] <= result.stats["linear_deflection"]
+    assert any("pulled towards their straight edges" in n for n in result.notes)
+    jac = mesh_pipeline.tet10_jacobians(result.mesh.points, result.mesh.tets)
+    assert (jac > 0).all()
+    off = []
+    for tag in sorted(set(result.boundary_face_tags.tolist())):
+        face = shape.Faces[tag]
+        for n in result.face_nodes(tag).tolist():
+            d = face.distToShape(Part.Vertex(freecad.Vector(*result.mesh.points[n])))[0]
+            if d > max(face.Tolerance, 1e-7):
+                off.append((n, d))
+                assert d <= repair["max_off_cad_mm"] * (1 + 1e-6) + 1e-9, (tag, n, d)
+    assert 0 < len({n for n, _ in off}) <= repair["straightened_boundary_midnodes"]
