@@ -22,6 +22,8 @@ namespace bsptet {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// flat_collapse_pass works on the tets below this min dihedral angle (degrees).
+constexpr double kFlatCollapseBelowDeg = 1.0;
 // Edge removals (RefineMesh::remove_edge) look at shells of at most this many tets.
 constexpr int kMaxEdgeRing = 7;
 
@@ -754,6 +756,52 @@ class Refiner {
     return n;
   }
 
+  // Removes Steiner corners of the tets below `below` degrees whatever their edge lengths: each
+  // such corner (not an input point) is collapsed onto one of its neighbours, nearest first,
+  // when every new tet is positive (exact) and the worst new tet is better than the worst tet
+  // around the corner was. Meant for flat tets that moving one point never mends: three nearly
+  // collinear Steiner points (the core's, moved a few ulps inside a plane) make a flat tet
+  // wherever its fourth corner goes. Each collapse removes a point, so the pass ends.
+  std::int64_t flat_collapse_pass(double below) {
+    std::int64_t n = 0;
+    std::vector<std::pair<double, Index>> near;
+    for (Index t : tets_below(below)) {
+      if (!m_.tet_alive(t) || m_.tet_quality(t) >= below) continue;
+      const auto q = m_.tet(t);
+      bool done = false;
+      for (int i = 0; i < 4 && !done; ++i) {
+        const Index from = q[i];
+        if (!m_.point_alive(from) || m_.support(from).kind == Support::kInputVertex) continue;
+        near.clear();
+        double old_min = 180;
+        for (Index s : m_.tets_around_point(from)) {
+          old_min = std::min(old_min, m_.tet_quality(s));
+          for (Index w : m_.tet(s))
+            if (w != from && std::find_if(near.begin(), near.end(), [&](const auto& p) { return p.second == w; }) == near.end())
+              near.emplace_back(length(from, w), w);
+        }
+        std::sort(near.begin(), near.end());
+        auto better = [&](const std::vector<std::array<Index, 4>>&, const std::vector<std::array<Index, 4>>& created) {
+          double worst = 180;
+          for (const auto& c : created)
+            worst = std::min(worst, tet_min_dihedral_deg(m_.point(c[0]), m_.point(c[1]), m_.point(c[2]), m_.point(c[3])));
+          return worst > old_min;
+        };
+        for (const auto& [l, to] : near) {
+          const double lim = o_.split_ratio * target(to);  // no edge longer than a split allows
+          if (m_.collapse_edge(from, to, 180.0, std::isfinite(lim) ? lim * lim : kInf, better)) {
+            ++n;
+            done = true;
+            break;
+          }
+        }
+      }
+    }
+    st_.flat_collapses += n;
+    st_.collapses += n;
+    return n;
+  }
+
   // Moves interior points towards the centroid of their neighbours when it helps the worst tet.
   std::int64_t smooth_pass(double below) {
     std::vector<Index> pts;
@@ -1029,6 +1077,7 @@ class Refiner {
       poll("optimizing", 0.5 + 0.5 * round / std::max(1, rounds));
       std::int64_t changes = 0;
       changes += timed("collapse", [&] { return collapse_pass(); });
+      changes += timed("collapse", [&] { return flat_collapse_pass(kFlatCollapseBelowDeg); });
       changes += timed("flip", [&] { return flip_pass(std::max(goal, 30.0)); });
       changes += timed("smooth", [&] { return smooth_pass(std::max(goal, 30.0)); });
       changes += timed("radius_edge", [&] { return radius_edge_pass(); });

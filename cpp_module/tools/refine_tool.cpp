@@ -4,9 +4,11 @@
 //
 //   bsptet_refine SURFACE.off [--size H | --size-diag N] [--min-size L] [--radius-edge B]
 //                 [--min-dihedral D] [--split-ratio R] [--thickness-ratio K] [--collapse-ratio C] [--optimize-rounds N]
-//                 [--max-passes N] [--rounded] [--write STEM]
+//                 [--max-passes N] [--rounded] [--write STEM] [--core-cache STEM]
 //
-// --size-diag N sets H to the bounding-box diagonal / N. Exit: 0 valid, 1 error or invalid, 2 bad input.
+// --size-diag N sets H to the bounding-box diagonal / N. --core-cache STEM reads the core's mesh
+// from STEM.node/.ele when they exist (else meshes and writes them there): the quality stage
+// alone, again and again, on a model whose core takes minutes. Exit: 0 valid, 1 error or invalid, 2 bad input.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,7 +34,7 @@ int main(int argc, char** argv) {
   }
   RefineOptions o;
   double size_diag = 0;
-  std::string stem;
+  std::string stem, core_cache;
   for (int i = 2; i < argc; ++i) {
     auto value = [&]() {
       if (i + 1 >= argc) {
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--max-passes")) o.max_passes = static_cast<int>(value());
     else if (!std::strcmp(argv[i], "--rounded")) o.surface_points = SurfacePoints::kRounded;
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
+    else if (!std::strcmp(argv[i], "--core-cache") && i + 1 < argc) core_cache = argv[++i];
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
       return 2;
@@ -71,7 +74,15 @@ int main(int argc, char** argv) {
                          (hi[2] - lo[2]) * (hi[2] - lo[2])) / size_diag;
     }
     MeshStats cst;
-    const TetMesh core = tetrahedralize(s, MeshOptions{}, &cst);
+    TetMesh core;
+    std::FILE* cached = core_cache.empty() ? nullptr : std::fopen((core_cache + ".node").c_str(), "r");
+    if (cached) {
+      std::fclose(cached);
+      core = read_tetgen(core_cache);
+    } else {
+      core = tetrahedralize(s, MeshOptions{}, &cst);
+      if (!core_cache.empty()) write_tetgen(core_cache, core);
+    }
     const MeshCheckReport before = check_mesh(s, core);
     RefineStats st;
     const TetMesh m = refine_quality(s, core, o, &st);

@@ -121,6 +121,8 @@ struct RefineStats {
   std::int64_t splits_rejected = 0;      ///< splits refused (a new tet not positive)
   std::int64_t projection_rejected = 0;  ///< hook results refused (non-finite)
   std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
+  /// Of `collapses`: Steiner corners of near-flat tets collapsed whatever their edge lengths.
+  std::int64_t flat_collapses = 0;
   std::int64_t edge_removals = 0;        ///< n-to-2(n-2) flips, 4 <= n <= 7 (RefineMesh::remove_edge)
   std::int64_t insertions = 0;           ///< interior points inserted where they raise the worst angle
   std::int64_t size_passes = 0, optimize_rounds = 0;
