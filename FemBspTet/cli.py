@@ -198,7 +198,8 @@ def _mesh_on_cad(args, progress):
     params = MeshParameters(max_size=args.size or 0.0, min_size=args.min_size or 0.0,
                             order=args.order, quality_bound=args.radius_edge or 0.0,
                             allow_boundary_steiner=args.allow_boundary_steiner,
-                            compare_tetgen=False)
+                            compare_tetgen=False,
+                            straighten_midnodes=not args.no_straighten_midnodes)
     if args.thickness_ratio is not None:
         params.thickness_ratio = args.thickness_ratio
     result = mesh_cad_shape(shape, params, progress=lambda stage, fraction: progress(stage),
@@ -211,6 +212,9 @@ def _cmd_mesh(args):
     t0 = time.perf_counter()
     if not hasattr(args, "max_memory_bytes"):
         _check_mesh_args(args)
+    if getattr(args, "no_straighten_midnodes", False) and not getattr(args, "on_cad", False):
+        raise InputError("--no-straighten-midnodes is for --on-cad (the FreeCAD mesher's curved "
+                         "tet10); without --on-cad tet10 mid-nodes stay on their straight edges")
     if getattr(args, "on_cad", False):
         progress("reading the CAD file")
         try:
@@ -459,6 +463,11 @@ def build_parser():
                         "points the refinement adds and tet10 mid-nodes go onto the CAD faces and "
                         "edges (OpenCASCADE), so the mesh follows the curved surface; without it "
                         "they stay on the tessellation's flat triangles")
+    m.add_argument("--no-straighten-midnodes", action="store_true",
+                   help="with --on-cad and --order 2: stop with the error where curved mid-nodes "
+                        "still invert elements after every mend, instead of pulling those "
+                        "mid-nodes towards their straight edges (a valid mesh, with a note on how "
+                        "many boundary mid-nodes are how far off the CAD)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.add_argument("--reorient", action="store_true",

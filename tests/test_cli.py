@@ -334,3 +334,12 @@ def test_mesh_on_cad_refuses_a_surface_file_and_core_only_options(cli, tmp_path)
     r = run(cli, "mesh", cad, "-o", tmp_path / "x.vtu", "--on-cad", "--reorient")
     assert r.returncode == 2 and "--reorient" in r.stderr
     assert not (tmp_path / "x.vtu").exists()
+
+
+def test_no_straighten_midnodes_is_refused_without_on_cad(cli, tmp_path):
+    """The flag belongs to the FreeCAD pipeline's curved tet10 (``--on-cad``): elsewhere it is
+    refused with the reason, and no file is written."""
+    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "x.vtu", "--order", "2",
+            "--no-straighten-midnodes")
+    assert r.returncode == 2 and "--no-straighten-midnodes is for --on-cad" in r.stderr
+    assert not (tmp_path / "x.vtu").exists()
