@@ -758,10 +758,12 @@ class Refiner {
 
   // Removes Steiner corners of the tets below `below` degrees whatever their edge lengths: each
   // such corner (not an input point) is collapsed onto one of its neighbours, nearest first,
-  // when every new tet is positive (exact) and the worst new tet is better than the worst tet
-  // around the corner was. Meant for flat tets that moving one point never mends: three nearly
-  // collinear Steiner points (the core's, moved a few ulps inside a plane) make a flat tet
-  // wherever its fourth corner goes. Each collapse removes a point, so the pass ends.
+  // when every new tet is positive (exact), none is worse than the worst tet around the corner
+  // was, and either the worst gets better or fewer tets are below `below` there. Meant for flat
+  // tets that moving one point never mends: three nearly collinear Steiner points make a flat tet
+  // wherever its fourth corner goes, and a layer of Steiner points a few ulps inside a plane (the
+  // core's relocated surface points) traps each of them between the plane and the others. Each
+  // collapse removes a point, so the pass ends.
   std::int64_t flat_collapse_pass(double below) {
     std::int64_t n = 0;
     std::vector<std::pair<double, Index>> near;
@@ -774,8 +776,10 @@ class Refiner {
         if (!m_.point_alive(from) || m_.support(from).kind == Support::kInputVertex) continue;
         near.clear();
         double old_min = 180;
+        std::size_t old_below = 0;
         for (Index s : m_.tets_around_point(from)) {
           old_min = std::min(old_min, m_.tet_quality(s));
+          old_below += m_.tet_quality(s) < below;
           for (Index w : m_.tet(s))
             if (w != from && std::find_if(near.begin(), near.end(), [&](const auto& p) { return p.second == w; }) == near.end())
               near.emplace_back(length(from, w), w);
@@ -783,9 +787,13 @@ class Refiner {
         std::sort(near.begin(), near.end());
         auto better = [&](const std::vector<std::array<Index, 4>>&, const std::vector<std::array<Index, 4>>& created) {
           double worst = 180;
-          for (const auto& c : created)
-            worst = std::min(worst, tet_min_dihedral_deg(m_.point(c[0]), m_.point(c[1]), m_.point(c[2]), m_.point(c[3])));
-          return worst > old_min;
+          std::size_t now_below = 0;
+          for (const auto& c : created) {
+            const double a = tet_min_dihedral_deg(m_.point(c[0]), m_.point(c[1]), m_.point(c[2]), m_.point(c[3]));
+            worst = std::min(worst, a);
+            now_below += a < below;
+          }
+          return worst > old_min || now_below < old_below;  // (collapse_edge: worst >= old_min)
         };
         for (const auto& [l, to] : near) {
           const double lim = o_.split_ratio * target(to);  // no edge longer than a split allows
