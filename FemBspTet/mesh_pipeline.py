@@ -30,7 +30,10 @@ Stages:
    (:mod:`FemBspTet.curved_untangle`: interior mid-nodes move, boundary nodes never); if some
    elements stay inverted, one more attempt meshes the tessellation with its folding curved
    triangles mended (:func:`repair_curved_folds_of`), and the attempt with fewer inverted
-   elements is kept.
+   elements is kept; then a tessellation with half the AngularDeflection is tried. Last resort
+   (``MeshParameters.straighten_midnodes``, on by default): the mid-nodes of the elements still
+   inverted are pulled towards their chords (:func:`straighten_inverted`), with a note naming how
+   many boundary mid-nodes are how far off which CAD faces.
 5. Moved nodes must not invert an element: every tet with a moved node is checked (positive
    signed volume of the corners; for tet10 a positive Jacobian determinant at the 10 nodes and
    the centroid). A failure raises InternalError naming the tet and the CAD face.
