@@ -21,6 +21,12 @@ from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
 from .mesh_types import Surface, TetMesh
 
 
+#: End of the note on tet10 mid-nodes the core left on their chords (after the count). The FreeCAD
+#: pipeline, which puts every boundary mid-node on the CAD afterwards, leaves it out.
+MIDNODES_STRAIGHTENED_NOTE = ("curved mid-nodes were put back on their chord (the curved tet would "
+                              "not have been valid)")
+
+
 @contextlib.contextmanager
 def _core_errors(surface, stage):
     """The core's errors as the package's: InputError (naming the input), Cancelled, and
@@ -273,8 +279,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
                 "faces by their nodes, may load those faces wrongly; a smaller size usually "
                 "removes them")
         if r.get("midnodes_straightened"):
-            notes.append(f"{r['midnodes_straightened']} curved mid-nodes were put back on their chord "
-                         "(the curved tet would not have been valid)")
+            notes.append(f"{r['midnodes_straightened']} {MIDNODES_STRAIGHTENED_NOTE}")
     stats["notes"] = notes
     return mesh, stats
 

@@ -549,7 +549,10 @@ def _mesh_cad_shape_once(shape, params, progress, cancel, source, repair_rounds=
         stats["tessellation_fins"] = fin_stats
     if remesh_stats:
         stats["surface_remesh"] = remesh_stats
-    notes = remesh_notes + list(stats.get("notes", []))
+    # (the core's note on mid-nodes it left on their chords no longer holds: every boundary
+    # mid-node went onto the CAD above, and what stays off is said below)
+    notes = remesh_notes + [n for n in stats.get("notes", [])
+                            if not n.endswith(core.MIDNODES_STRAIGHTENED_NOTE)]
     if projection.disjoint_placements:
         pairs = sorted({", ".join("Face%d" % (t + 1) for t in ts)
                         for ts in projection.disjoint_placements})
