@@ -204,17 +204,19 @@ def straighten_midnodes(points, tets, bad, cancel=None):
     and, for each, its distance from where it was.
     """
     bad = np.unique(np.asarray(bad, dtype=np.int64))
-    empty = np.zeros(0, dtype=np.int64)
     if len(bad) == 0:
-        return bad, empty, np.zeros(0)
+        return bad, np.zeros(0, dtype=np.int64), np.zeros(0)
     edges = np.array(_EDGES)
-    # owners of each mid-node, and its chord's midpoint
-    owners = {}
-    chord = {}
-    for k in range(6):
-        col = tets[:, 4 + k]
-        for e, m in enumerate(col.tolist()):
-            owners.setdefault(m, []).append(e)
+    # the elements containing each mid-node: element indices grouped by node (sorted once)
+    slots = tets[:, 4:10].reshape(-1)
+    order = np.argsort(slots, kind="stable")
+    grouped = slots[order]
+
+    def owners(m):
+        lo, hi = np.searchsorted(grouped, [m, m + 1])
+        return (order[lo:hi] // 6).tolist()
+
+    chord = {}  # each pulled mid-node's chord midpoint
     _, scale = _scales(points, tets)
 
     def mid_of(e, k):
@@ -244,14 +246,14 @@ def straighten_midnodes(points, tets, bad, cancel=None):
                 pulled_now.append(m)
         if not pulled_now:
             break  # what is left has inverted corners
-        around = sorted({e for m in pulled_now for e in owners[m]} | pending)
+        around = sorted({e for m in pulled_now for e in owners(m)} | pending)
         q = quality(around)
         pending = {e for e, v in zip(around, q.tolist()) if v <= 0}
     pulled = np.array(sorted(home), dtype=np.int64)
     for m in pulled.tolist():
         if cancel is not None:
             cancel()
-        elems = owners[m]
+        elems = owners(m)
         on_chord = quality(elems)
         floor = np.where(on_chord > 0, 0.5 * on_chord, np.inf)
         for frac in STRAIGHTEN_FRACTIONS:
@@ -260,7 +262,7 @@ def straighten_midnodes(points, tets, bad, cancel=None):
                 break
         else:
             points[m] = chord[m]
-    touched = sorted({e for m in pulled.tolist() for e in owners[m]} | set(bad.tolist()))
+    touched = sorted({e for m in pulled.tolist() for e in owners(m)} | set(bad.tolist()))
     q = quality(touched)
     still_bad = np.array([e for e, v in zip(touched, q.tolist()) if v <= 0], dtype=np.int64)
     off = np.array([float(np.linalg.norm(points[m] - home[m])) for m in pulled.tolist()])

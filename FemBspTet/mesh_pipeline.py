@@ -778,10 +778,7 @@ def slide_boundary_midnodes(mesh, faces, tags, midnodes, bad, projection, rounds
     if len(bad) == 0 or len(midnodes) == 0:
         return bad, np.zeros(0, dtype=np.int64)
     pts, tets = mesh.points, mesh.tets
-    node_tags = {}
-    for f, t in zip(np.asarray(midnodes).tolist(), tags.tolist()):
-        for m in f:
-            node_tags.setdefault(m, set()).add(int(t))
+    node_tags = midnode_face_tags(midnodes, tags)
     owners = {}
     hit_e, hit_k = np.nonzero(np.isin(tets[:, 4:10], list(node_tags)))
     for e, k in zip(hit_e.tolist(), hit_k.tolist()):
@@ -830,6 +827,16 @@ def slide_boundary_midnodes(mesh, faces, tags, midnodes, bad, projection, rounds
     return bad, np.array(sorted(slid), dtype=np.int64)
 
 
+def midnode_face_tags(midnodes, tags):
+    """``{boundary mid-node: set of CAD face tags}``: the tags of the boundary triangles whose
+    edges it is the mid-node of (``midnodes`` (k, 3) and ``tags`` (k,) per boundary triangle)."""
+    node_tags = {}
+    for f, t in zip(np.asarray(midnodes).tolist(), np.asarray(tags).tolist()):
+        for m in f:
+            node_tags.setdefault(m, set()).add(int(t))
+    return node_tags
+
+
 def straighten_inverted(mesh, midnodes, tags, bad, projection, cancel=None):
     """:func:`FemBspTet.curved_untangle.straighten_midnodes` on the elements ``bad`` of a tet10
     mesh (``mesh.points`` changed in place). Returns ``(still bad, stats)``; the stats say how
@@ -841,11 +848,8 @@ def straighten_inverted(mesh, midnodes, tags, bad, projection, cancel=None):
 
     count = int(len(bad))
     still, pulled, _ = straighten_midnodes(mesh.points, mesh.tets, bad, cancel=cancel)
-    node_tags = {}
-    wanted = set(pulled.tolist())
-    for row, t in zip(np.asarray(midnodes).tolist(), tags.tolist()):
-        for m in wanted.intersection(row):
-            node_tags.setdefault(m, set()).add(int(t))
+    every = midnode_face_tags(midnodes, tags)
+    node_tags = {m: every[m] for m in pulled.tolist() if m in every}  # the boundary ones
     off = 0.0
     for m, ts in sorted(node_tags.items()):
         q = np.array(projection.to_faces(mesh.points[m], ts), dtype=np.float64)
