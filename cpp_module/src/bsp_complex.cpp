@@ -189,6 +189,8 @@ void BspComplex::split_edge(Index u, Index w, Index x) {
   if (it == edge_faces_.end()) return;
   const std::vector<Index> users = it->second;  // copy: registration changes the map
   for (Index g : users) {
+    if (face_untouched(g) >= 0)
+      throw MeshingError(ErrorCode::kInternal, "bsp", g, "a split reached an edge of an untouched seed tet");
     geo_.note_on_plane(x, faces_[g].plane);  // x is on the edge, so on every face using it
     unregister_edges(g);
     auto& v = faces_[g].verts;
@@ -257,6 +259,8 @@ std::array<Index, 2> BspComplex::split_face(Index f, Index q, VertexSigns& sign)
     if (mx > 0) h[0].coplanar.push_back(t);
     if (mn < 0) h[1].coplanar.push_back(t);
   }
+  if (face_untouched(f) >= 0)
+    throw MeshingError(ErrorCode::kInternal, "bsp", f, "a split reached a face of an untouched seed tet");
   unregister_edges(f);
   faces_[f].alive = false;
   const Index i0 = new_face(std::move(h[0]));
@@ -563,6 +567,8 @@ bool BspComplex::segment_crosses_face(Index f, Index a, Index b, int axis, int f
 }
 
 void BspComplex::replace_face(Index f, std::vector<BspFace> pieces) {
+  if (face_untouched(f) >= 0)
+    throw MeshingError(ErrorCode::kInternal, "bsp", f, "a split reached a face of an untouched seed tet");
   unregister_edges(f);
   faces_[f].alive = false;
   std::vector<Index> ids;

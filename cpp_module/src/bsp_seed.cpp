@@ -35,6 +35,7 @@
 #include "bsptet/errors.h"
 #include "bsptet/exact_float.h"
 #include "bsptet/interval.h"
+#include "bsptet/point_delaunay.h"
 #include "bsptet/predicates.h"
 
 namespace bsptet {
@@ -328,11 +329,39 @@ class SeedFlips {
     return false;
   }
 
-  /// The alive tets, in order.
-  std::vector<Tet> result() const {
-    std::vector<Tet> out;
+  /// The alive tets, in order, and their neighbours (as PointDelaunay::nb): `nb` holds those of
+  /// the first tets before any flip (the tets given to the constructor) and becomes those of the
+  /// result. A neighbour that a flip replaced, and every neighbour of a new tet, is found through
+  /// the vertex's tets.
+  std::vector<Tet> result(std::vector<std::array<Index, 4>>& nb) const {
+    const std::size_t first = nb.size();
+    std::vector<Index> renumber(tets_.size(), -1);
+    Index m = 0;
     for (std::size_t t = 0; t < tets_.size(); ++t)
-      if (alive_[t]) out.push_back(tets_[t]);
+      if (alive_[t]) renumber[t] = m++;
+    std::vector<Tet> out;
+    std::vector<std::array<Index, 4>> out_nb;
+    out.reserve(static_cast<std::size_t>(m));
+    out_nb.reserve(static_cast<std::size_t>(m));
+    for (std::size_t t = 0; t < tets_.size(); ++t) {
+      if (!alive_[t]) continue;
+      const Tet& q = tets_[t];
+      std::array<Index, 4> n;
+      for (int i = 0; i < 4; ++i) {
+        const Index old = t < first ? nb[t][i] : -2;
+        if (old == -1) {
+          n[i] = -1;  // the hull: never flipped
+        } else if (old >= 0 && alive_[old]) {
+          n[i] = renumber[old];
+        } else {
+          const Index o = tet_with(q[kFace[i][0]], q[kFace[i][1]], q[kFace[i][2]], static_cast<Index>(t));
+          n[i] = o < 0 ? -1 : renumber[o];
+        }
+      }
+      out.push_back(q);
+      out_nb.push_back(n);
+    }
+    nb = std::move(out_nb);
     return out;
   }
   std::int64_t flips() const { return flips_; }
@@ -644,10 +673,11 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   order.reserve(keyed.size() + 8);
   for (Index c = corner0_; c < corner0_ + 8; ++c) order.push_back(c);
   for (const auto& kv : keyed) order.push_back(kv.second);
-  CellDelaunay dt;
-  if (!delaunay_points(geo_, std::move(order), dt))
+  PointDelaunay dt;
+  if (!delaunay_explicit_points(geo_, order, dt))
     throw MeshingError(ErrorCode::kInternal, "bsp", -1, "the Delaunay seed of the input points failed");
   std::vector<std::array<Index, 4>> tets = std::move(dt.tets);
+  std::vector<std::array<Index, 4>> nb = std::move(dt.nb);
   lap("seed_delaunay");
   {
     SeedFlips flips(tets, corner0_ + 8, point_of);
@@ -668,112 +698,75 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       if (flips.recover_face(a, b, c)) ++stats_.seed_recovered_faces;
     }
     stats_.seed_flips = flips.flips();
-    if (flips.flips() > 0) tets = flips.result();
+    if (flips.flips() > 0) tets = flips.result(nb);
   }
   const Index nt = static_cast<Index>(tets.size());
   stats_.seed_tets = nt;
   lap("seed_flips");
 
-  // 2. Faces: one per distinct triangle of the tets, shared by its (one or two) tets.
-  struct Slot {
-    std::array<Index, 3> key;
-    Index tet;
-    int i;
+  // 2. Faces: one per distinct triangle of the tets, shared by its (one or two) tets. They are
+  // light records here; only those of the tets that go into the complex (step 4) become BspFaces.
+  // A seed face: verts CCW around its normal, tet[0] on the positive side (the normal points into
+  // it), tet[1] on the negative side (-1: none). plane: the input plane it lies on, or -1 (not on
+  // one: the complex gives it a plane of its own through its corners, in this vertex order).
+  struct SeedFace {
+    std::array<Index, 3> verts;
+    Index plane;
+    Index tet[2];
+    std::vector<Index> coplanar;
   };
-  std::vector<Slot> slots;
-  slots.reserve(4 * static_cast<std::size_t>(nt));
-  for (Index t = 0; t < nt; ++t)
-    for (int i = 0; i < 4; ++i) {
-      std::array<Index, 3> key{{tets[t][kFace[i][0]], tets[t][kFace[i][1]], tets[t][kFace[i][2]]}};
-      std::sort(key.begin(), key.end());
-      slots.push_back({key, t, i});
-    }
-  std::sort(slots.begin(), slots.end(), [](const Slot& a, const Slot& b) {
-    return a.key != b.key ? a.key < b.key : (a.tet != b.tet ? a.tet < b.tet : a.i < b.i);
-  });
-  // Capacity for the seed and an eighth more for the splits: growing a vector doubles it (and
-  // holds old and new at once), which made these two vectors the peak of the BSP's memory.
-  {
-    std::size_t num_faces = 0;
-    for (std::size_t s = 0; s < slots.size(); ++s) num_faces += s == 0 || slots[s].key != slots[s - 1].key;
-    faces_.reserve(faces_.size() + num_faces + num_faces / 8);
-    cells_.reserve(static_cast<std::size_t>(nt) + static_cast<std::size_t>(nt) / 8);
-    // Edges of a tetrahedralization: about points + tets (Euler), so the edge maps never rehash
-    // while the seed's faces register theirs.
-    const std::size_t num_edges = static_cast<std::size_t>(corner0_ + 8) + static_cast<std::size_t>(nt);
-    edge_faces_.reserve(edge_faces_.size() + num_edges + num_edges / 8);
-    edge_line_.reserve(edge_line_.size() + num_edges + num_edges / 8);
-  }
-  cells_.assign(static_cast<std::size_t>(nt), BspCell{});
-  std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1}), nb(nt, {-1, -1, -1, -1});
+  std::vector<SeedFace> sfaces;
+  sfaces.reserve(2 * static_cast<std::size_t>(nt) + 8);
+  std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1});
+  // The input plane a face lies on by its corners' triangles: every corner an input point known
+  // on one plane (no arithmetic). A face whose corners lie on an input plane without all being
+  // known on it keeps a plane of its own here; the walk of step 3 gives it the input plane when a
+  // triangle of that plane touches it (the only case where its coverage matters).
   auto input_plane_of = [&](Index x, Index y, Index z) -> Index {
-    for (Index w : {x, y, z}) {
-      if (w >= corner0_) continue;
-      // By index, no copy: side() may note a plane (append to this list) for implicit vertices;
-      // these are explicit, and an appended plane would only be looked at too.
-      for (std::size_t k = 0; k < geo_.known_planes(w).size(); ++k) {
-        const Index q = geo_.known_planes(w)[k];
-        if (q >= input_planes) continue;
-        bool on = true;
-        for (Index o : {x, y, z})
-          if (o != w && !geo_.known_on_plane(o, q) && geo_.side(q, o) != Sign::kZero) {
-            on = false;
-            break;
-          }
-        if (on) return q;
-      }
-    }
+    if (x >= corner0_ || y >= corner0_ || z >= corner0_) return -1;
+    for (Index q : geo_.known_planes(x))
+      if (q < input_planes && geo_.known_on_plane(y, q) && geo_.known_on_plane(z, q)) return q;
     return -1;
   };
-  std::vector<std::pair<std::array<Index, 3>, Index>> face_of_corners;  // sorted corners -> face, sorted
-  face_of_corners.reserve(slots.size() / 2 + 1);
-  for (std::size_t s = 0; s < slots.size();) {
-    std::size_t e = s + 1;
-    while (e < slots.size() && slots[e].key == slots[s].key) ++e;
-    if (e - s > 2) throw MeshingError(ErrorCode::kInternal, "bsp", -1, "a Delaunay seed face has more than two tets");
-    const Index t0 = slots[s].tet, t1 = e - s == 2 ? slots[s + 1].tet : -1;
-    const int i0 = slots[s].i;
-    const Index x = tets[t0][kFace[i0][0]], y = tets[t0][kFace[i0][1]], z = tets[t0][kFace[i0][2]];
-    const Index apex = tets[t0][i0];  // on the positive side of (x, y, z)
-    BspFace f;
-    const Index q = input_plane_of(x, y, z);
-    if (q >= 0) {
-      f.plane = q;
-      const Sign side = geo_.side(q, apex);
-      if (side == Sign::kZero) throw MeshingError(ErrorCode::kInternal, "bsp", t0, "a flat Delaunay seed tet");
-      if (side == Sign::kPositive) {
-        f.verts = {x, y, z};
-        f.cell[0] = t0;
-        f.cell[1] = t1;
-      } else {
-        f.verts = {x, z, y};
-        f.cell[0] = t1;
-        f.cell[1] = t0;
+  // Input-plane faces by their sorted corners (an input triangle that is a face of the seed is
+  // found here), sorted.
+  std::vector<std::pair<std::array<Index, 3>, Index>> face_of_corners;
+  for (Index t0 = 0; t0 < nt; ++t0)
+    for (int i0 = 0; i0 < 4; ++i0) {
+      const Index t1 = nb[t0][i0];
+      if (t1 >= 0 && t1 < t0) continue;  // made from the neighbour
+      const Index x = tets[t0][kFace[i0][0]], y = tets[t0][kFace[i0][1]], z = tets[t0][kFace[i0][2]];
+      const Index apex = tets[t0][i0];  // on the positive side of (x, y, z)
+      SeedFace f{{x, y, z}, -1, {t0, t1}, {}};
+      const Index q = input_plane_of(x, y, z);
+      const Index id = static_cast<Index>(sfaces.size());
+      if (q >= 0) {
+        f.plane = q;
+        const Sign side = geo_.side(q, apex);
+        if (side == Sign::kZero) throw MeshingError(ErrorCode::kInternal, "bsp", t0, "a flat Delaunay seed tet");
+        if (side == Sign::kNegative) {
+          f.verts = {x, z, y};
+          f.tet[0] = t1;
+          f.tet[1] = t0;
+        }
+        std::array<Index, 3> key{{x, y, z}};
+        std::sort(key.begin(), key.end());
+        face_of_corners.push_back({key, id});
       }
-    } else {
-      f.plane = geo_.add_plane(geo_.explicit_id(x), geo_.explicit_id(y), geo_.explicit_id(z));
-      f.verts = {x, y, z};
-      f.cell[0] = t0;
-      f.cell[1] = t1;
+      sfaces.push_back(std::move(f));
+      tet_face[t0][i0] = id;
+      if (t1 >= 0) {
+        int i1 = 0;
+        while (i1 < 4 && nb[t1][i1] != t0) ++i1;
+        if (i1 == 4) throw MeshingError(ErrorCode::kInternal, "bsp", t0, "Delaunay seed neighbours disagree");
+        tet_face[t1][i1] = id;
+      }
     }
-    const Index id = new_face(std::move(f));
-    face_of_corners.push_back({slots[s].key, id});
-    tet_face[t0][i0] = id;
-    if (t1 >= 0) {
-      tet_face[t1][slots[s + 1].i] = id;
-      nb[t0][i0] = t1;
-      nb[t1][slots[s + 1].i] = t0;
-    }
-    s = e;
-  }
+  std::sort(face_of_corners.begin(), face_of_corners.end());
   std::vector<Index> vertex_tet(static_cast<std::size_t>(corner0_ + 8), -1);
-  // A cell's face boxes are left to split_cell, which builds them when they are out of step:
-  // most seed tets are never split, and four boxes per tet were a fifth of the seed's memory.
-  for (Index t = 0; t < nt; ++t) {
-    cells_[t].faces.assign(tet_face[t].begin(), tet_face[t].end());
+  for (Index t = 0; t < nt; ++t)
     for (int i = 0; i < 4; ++i)
       if (vertex_tet[tets[t][i]] < 0) vertex_tet[tets[t][i]] = t;
-  }
 
   lap("seed_faces");
   // 3. Conflict lists and coplanar lists. An input triangle that is a face of the seed crosses
@@ -781,6 +774,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // face: it goes on that face's coplanar list, nothing more. Any other triangle walks over the
   // tets it meets; those whose interior it crosses (tet_triangle_relation, exact) get it on their
   // conflict list.
+  std::vector<std::vector<Index>> conflict(static_cast<std::size_t>(nt));
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<Index> queue;
@@ -794,8 +788,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       std::sort(key.begin(), key.end());
       const auto it = std::lower_bound(face_of_corners.begin(), face_of_corners.end(),
                                        std::pair<std::array<Index, 3>, Index>{key, -1});
-      if (it != face_of_corners.end() && it->first == key && faces_[it->second].plane == plane) {
-        faces_[it->second].coplanar.push_back(tr);
+      if (it != face_of_corners.end() && it->first == key && sfaces[it->second].plane == plane) {
+        sfaces[it->second].coplanar.push_back(tr);
         ++stats_.seed_face_triangles;
         continue;
       }
@@ -813,7 +807,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       const int rel = tet_triangle_relation(p, tets[t], q, qid);
       if (rel == 0) continue;
       if (rel == 2) {
-        cells_[t].conflict.push_back(tr);
+        conflict[t].push_back(tr);
         if (++stats_.seed_conflicts > max_conflicts && max_conflicts >= 0) {
           stats_.seed_abandoned = true;
           lap("seed_walk");
@@ -821,17 +815,18 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
         }
       }
       for (int i = 0; i < 4; ++i) {
-        BspFace& f = faces_[tet_face[t][i]];
-        // A face given a plane of its own may still lie on this triangle's plane (none of its
-        // corners is a corner of that plane's triangles, step 2): then it takes the input plane,
-        // decided exactly, so that the coverage and the classification see it.
-        if (f.plane >= input_planes && (!f.box.ok || geo_.side_of_box(plane, f.box.box) == Sign::kZero) &&
+        SeedFace& f = sfaces[tet_face[t][i]];
+        // A face not on an input plane by its corners' triangles may still lie on this
+        // triangle's plane (none of its corners is a corner of that plane's triangles, step 2):
+        // then it takes the input plane, decided exactly, so that the coverage and the
+        // classification see it.
+        if (f.plane < 0 &&
             std::all_of(f.verts.begin(), f.verts.end(), [&](Index v) { return geo_.side(plane, v) == Sign::kZero; })) {
           const Sign apex_side = geo_.side(plane, tets[t][i]);
           if (apex_side == Sign::kZero) throw MeshingError(ErrorCode::kInternal, "bsp", t, "a flat Delaunay seed tet");
-          if ((f.cell[0] == t) != (apex_side == Sign::kPositive)) {
+          if ((f.tet[0] == t) != (apex_side == Sign::kPositive)) {
             std::reverse(f.verts.begin(), f.verts.end());
-            std::swap(f.cell[0], f.cell[1]);
+            std::swap(f.tet[0], f.tet[1]);
           }
           f.plane = plane;
           ++stats_.seed_faces_relabelled;
@@ -845,17 +840,145 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       }
     }
   }
+  std::vector<std::uint32_t>().swap(seen);
   lap("seed_walk");
-  // 4. Edge lines: the planes of the two faces of a tet through the edge (never the same
-  // geometric plane), taken after the walk, which may have given faces their input plane.
+
+  // 4. Which tets go into the complex (UntouchedSeedTets, bsp_complex.h): those with an edge of a
+  // crossed tet or of a face on an input plane that is not exactly one input triangle (a face
+  // refine_covered_faces would split).
+  auto is_input_triangle = [&](std::array<Index, 3> a, const std::vector<Index>& coplanar) {
+    if (coplanar.size() != 1) return false;
+    std::array<Index, 3> b{{triangle_vertex(coplanar[0], 0), triangle_vertex(coplanar[0], 1),
+                            triangle_vertex(coplanar[0], 2)}};
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    return a == b;
+  };
+  auto needs_refinement = [&](const SeedFace& f) {
+    return f.plane >= 0 && !f.coplanar.empty() && !is_input_triangle(f.verts, f.coplanar);
+  };
+  std::vector<std::uint64_t> hot;
+  for (Index t = 0; t < nt; ++t)
+    if (!conflict[t].empty())
+      for (const auto& ed : kEdge) hot.push_back(edge_key(tets[t][ed[0]], tets[t][ed[1]]));
+  for (const SeedFace& f : sfaces)
+    if (needs_refinement(f))
+      for (int k = 0; k < 3; ++k) hot.push_back(edge_key(f.verts[k], f.verts[(k + 1) % 3]));
+  std::sort(hot.begin(), hot.end());
+  hot.erase(std::unique(hot.begin(), hot.end()), hot.end());
+  std::vector<char> hot_vertex(static_cast<std::size_t>(corner0_ + 8), 0);
+  for (std::uint64_t k : hot) {
+    hot_vertex[static_cast<std::size_t>(k >> 32)] = 1;
+    hot_vertex[static_cast<std::size_t>(k & 0xffffffffu)] = 1;
+  }
+  std::vector<Index> cell_of(static_cast<std::size_t>(nt), -1), untouched_of(static_cast<std::size_t>(nt), -1);
+  Index num_cells = 0, num_untouched = 0;
   for (Index t = 0; t < nt; ++t) {
+    bool in = false;
+    for (const auto& ed : kEdge) {
+      const Index a = tets[t][ed[0]], b = tets[t][ed[1]];
+      if (hot_vertex[a] && hot_vertex[b] && std::binary_search(hot.begin(), hot.end(), edge_key(a, b))) {
+        in = true;
+        break;
+      }
+    }
+    (in ? cell_of[t] = num_cells++ : untouched_of[t] = num_untouched++);
+  }
+  std::vector<std::uint64_t>().swap(hot);
+  stats_.untouched_tets = num_untouched;
+  stats_.leaves += num_untouched;
+
+  // 5. The complex: the cells of those tets and their faces. A face between a cell and an
+  // untouched tet keeps cell -1 on that side and remembers the tet (face_untouched).
+  {
+    std::size_t num_faces = 0;
+    for (const SeedFace& f : sfaces)
+      num_faces += (f.tet[0] >= 0 && cell_of[f.tet[0]] >= 0) || (f.tet[1] >= 0 && cell_of[f.tet[1]] >= 0);
+    // Capacity for the seed and an eighth more for the splits: growing a vector doubles it (and
+    // holds old and new at once), which made these two vectors the peak of the BSP's memory.
+    faces_.reserve(faces_.size() + num_faces + num_faces / 8);
+    const auto ncells = static_cast<std::size_t>(num_cells);
+    cells_.reserve(ncells + ncells / 8);
+    // Edges: about (faces + vertices) / 2 for the cells' part of a tetrahedralization (Euler), so
+    // the edge maps never rehash while the faces register theirs.
+    const std::size_t num_edges = num_faces / 2 + 4 * ncells / 3 + 8;
+    edge_faces_.reserve(edge_faces_.size() + num_edges + num_edges / 8);
+    edge_line_.reserve(edge_line_.size() + num_edges + num_edges / 8);
+  }
+  cells_.assign(static_cast<std::size_t>(num_cells), BspCell{});
+  std::vector<Index> complex_face(sfaces.size(), -1);
+  for (std::size_t i = 0; i < sfaces.size(); ++i) {
+    SeedFace& f = sfaces[i];
+    const Index c0 = f.tet[0] >= 0 ? cell_of[f.tet[0]] : -1, c1 = f.tet[1] >= 0 ? cell_of[f.tet[1]] : -1;
+    if (c0 < 0 && c1 < 0) continue;
+    BspFace bf;
+    bf.plane = f.plane >= 0 ? f.plane
+                            : geo_.add_plane(geo_.explicit_id(f.verts[0]), geo_.explicit_id(f.verts[1]),
+                                             geo_.explicit_id(f.verts[2]));
+    bf.verts.assign(f.verts.begin(), f.verts.end());
+    bf.cell[0] = c0;
+    bf.cell[1] = c1;
+    bf.coplanar = std::move(f.coplanar);
+    const Index id = new_face(std::move(bf));
+    complex_face[i] = id;
+    const Index other = c0 < 0 ? f.tet[0] : (c1 < 0 ? f.tet[1] : -1);
+    if (other >= 0) {
+      if (face_untouched_.size() <= static_cast<std::size_t>(id)) face_untouched_.resize(id + 1, -1);
+      face_untouched_[id] = untouched_of[other];
+    }
+  }
+  // A cell's face boxes are left to split_cell, which builds them when they are out of step:
+  // most seed tets are never split, and four boxes per tet were a fifth of the seed's memory.
+  for (Index t = 0; t < nt; ++t) {
+    if (cell_of[t] < 0) continue;
+    BspCell& cell = cells_[cell_of[t]];
+    for (int i = 0; i < 4; ++i) cell.faces.push_back(complex_face[tet_face[t][i]]);
+    cell.conflict = std::move(conflict[t]);
+  }
+  untouched_.tets.reserve(static_cast<std::size_t>(num_untouched));
+  untouched_.adj.reserve(static_cast<std::size_t>(num_untouched));
+  untouched_.step.reserve(static_cast<std::size_t>(num_untouched));
+  untouched_.cover.reserve(static_cast<std::size_t>(num_untouched));
+  for (Index t = 0; t < nt; ++t) {
+    if (untouched_of[t] < 0) continue;
+    std::array<Index, 4> adj, cover{{-1, -1, -1, -1}};
+    std::array<signed char, 4> step{{0, 0, 0, 0}};
+    for (int i = 0; i < 4; ++i) {
+      const Index n = nb[t][i];
+      adj[i] = n < 0 ? -1 : (cell_of[n] >= 0 ? -2 - complex_face[tet_face[t][i]] : untouched_of[n]);
+      const Index fi = tet_face[t][i];
+      // (A face shared with a cell handed its coplanar list to the complex.)
+      const std::vector<Index>& cop = complex_face[fi] >= 0 ? faces_[complex_face[fi]].coplanar : sfaces[fi].coplanar;
+      if (sfaces[fi].plane < 0 || cop.empty()) continue;
+      const Index tr = cop[0];
+      if (!is_input_triangle(sfaces[fi].verts, cop))
+        throw MeshingError(ErrorCode::kInternal, "bsp", tr, "an untouched seed tet has a face that needs refinement");
+      // +1 when the triangle (a, b, c), outward, turns like the face (x, y, z) whose normal
+      // points into t: then the outside is on t's side.
+      const Index x = tets[t][kFace[i][0]], y = tets[t][kFace[i][1]];
+      const Index a = triangle_vertex(tr, 0), b = triangle_vertex(tr, 1), c = triangle_vertex(tr, 2);
+      const bool same_turn = (x == a && y == b) || (x == b && y == c) || (x == c && y == a);
+      step[i] = same_turn ? 1 : -1;
+      cover[i] = tr;
+    }
+    untouched_.tets.push_back(tets[t]);
+    untouched_.adj.push_back(adj);
+    untouched_.step.push_back(step);
+    untouched_.cover.push_back(cover);
+  }
+  lap("seed_cells");
+  // 6. Edge lines of the cells: the planes of the two faces of a tet through the edge (never the
+  // same geometric plane), taken after the walk, which may have given faces their input plane.
+  for (Index t = 0; t < nt; ++t) {
+    if (cell_of[t] < 0) continue;
     for (const auto& ed : kEdge) {
       const std::uint64_t key = edge_key(tets[t][ed[0]], tets[t][ed[1]]);
       if (edge_line_.count(key)) continue;
       int other[2], m = 0;
       for (int j = 0; j < 4; ++j)
         if (j != ed[0] && j != ed[1]) other[m++] = j;
-      edge_line_[key] = {faces_[tet_face[t][other[0]]].plane, faces_[tet_face[t][other[1]]].plane};
+      edge_line_[key] = {faces_[complex_face[tet_face[t][other[0]]]].plane,
+                         faces_[complex_face[tet_face[t][other[1]]]].plane};
     }
   }
   lap("seed_lines");

@@ -60,47 +60,102 @@ CellLabels classify_cells(BspComplex& bsp) {
   }
 
   constexpr int kUnset = std::numeric_limits<int>::min();
-  out.winding.assign(cells.size(), kUnset);
+  // Nodes of the propagation: cells 0..#cells-1, then the untouched seed tets.
+  const UntouchedSeedTets& ut = bsp.untouched();
+  const Index nc = static_cast<Index>(cells.size());
+  const Index nu = static_cast<Index>(ut.tets.size());
+  std::vector<int> w(static_cast<std::size_t>(nc + nu), kUnset);
   std::deque<Index> queue;
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    if (!faces[f].alive) continue;
-    for (int s = 0; s < 2; ++s)
-      if (faces[f].cell[s] < 0 && faces[f].cell[1 - s] >= 0 && out.winding[faces[f].cell[1 - s]] == kUnset) {
-        out.winding[faces[f].cell[1 - s]] = 0;
-        queue.push_back(faces[f].cell[1 - s]);
-      }
-  }
+  auto reach = [&](Index node, int value, Index blame_tri) {
+    if (w[node] == kUnset) {
+      w[node] = value;
+      queue.push_back(node);
+    } else if (w[node] != value) {
+      throw InputError(ErrorCode::kInconsistentOrientation, "classify", blame_tri,
+                       "the surface does not bound a solid near input triangle " + std::to_string(blame_tri) +
+                           ": it is open, inconsistently oriented, or self-intersecting there");
+    }
+  };
   auto blame = [&](Index f) -> Index {
     if (cover_tri[f] >= 0) return cover_tri[f];
     return faces[f].coplanar.empty() ? -1 : faces[f].coplanar[0];
   };
+  // Winding 0 next to the box: cells with a face whose other side is outside the box, untouched
+  // tets with a face on the box's hull.
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    if (!faces[f].alive || bsp.face_untouched(static_cast<Index>(f)) >= 0) continue;
+    for (int s = 0; s < 2; ++s)
+      if (faces[f].cell[s] < 0 && faces[f].cell[1 - s] >= 0 && w[faces[f].cell[1 - s]] == kUnset) {
+        w[faces[f].cell[1 - s]] = 0;
+        queue.push_back(faces[f].cell[1 - s]);
+      }
+  }
+  for (Index u = 0; u < nu; ++u)
+    for (int i = 0; i < 4; ++i)
+      if (ut.adj[u][i] == -1 && w[nc + u] == kUnset) {
+        w[nc + u] = 0;
+        queue.push_back(nc + u);
+      }
   while (!queue.empty()) {
-    const Index c = queue.front();
+    const Index node = queue.front();
     queue.pop_front();
+    if (node >= nc) {
+      const Index u = node - nc;
+      for (int i = 0; i < 4; ++i) {
+        const Index a = ut.adj[u][i];
+        if (a == -1) continue;
+        if (a >= 0) {
+          reach(nc + a, w[node] + ut.step[u][i], ut.cover[u][i]);
+          continue;
+        }
+        // A complex face with this tet on its cell -1 side.
+        const Index f = -2 - a;
+        const BspFace& face = faces[f];
+        const int cov = out.coverage[f];
+        if (face.cell[1] < 0)
+          reach(face.cell[0], w[node] - cov, blame(f));
+        else
+          reach(face.cell[1], w[node] + cov, blame(f));
+      }
+      continue;
+    }
+    const Index c = node;
     for (Index f : cells[c].faces) {
       const BspFace& face = faces[f];
-      if (face.cell[0] < 0 || face.cell[1] < 0) continue;
-      const int w0 = out.winding[face.cell[0]], w1 = out.winding[face.cell[1]];
       const int cov = out.coverage[f];
-      Index other = -1;
-      int expect = 0;
-      if (face.cell[0] == c) {
-        other = face.cell[1];
-        expect = w0 + cov;
-      } else {
-        other = face.cell[0];
-        expect = w1 - cov;
+      const Index u = bsp.face_untouched(f);
+      if (face.cell[0] < 0 || face.cell[1] < 0) {
+        if (u < 0) continue;  // outside the box
+        if (face.cell[0] == c)
+          reach(nc + u, w[c] + cov, blame(f));
+        else
+          reach(nc + u, w[c] - cov, blame(f));
+        continue;
       }
-      if (out.winding[other] == kUnset) {
-        out.winding[other] = expect;
-        queue.push_back(other);
-      } else if (out.winding[other] != expect) {
-        const Index t = blame(f);
-        throw InputError(ErrorCode::kInconsistentOrientation, "classify", t,
-                         "the surface does not bound a solid near input triangle " + std::to_string(t) +
-                             ": it is open, inconsistently oriented, or self-intersecting there");
-      }
+      if (face.cell[0] == c)
+        reach(face.cell[1], w[c] + cov, blame(f));
+      else
+        reach(face.cell[0], w[c] - cov, blame(f));
     }
+  }
+  auto check_winding = [&](int wn, Index t) {
+    if (wn != 0 && wn != 1)
+      throw InputError(wn < 0 ? ErrorCode::kInwardFacing : ErrorCode::kSelfIntersection, "classify", t,
+                       wn < 0 ? "the surface faces inward near input triangle " + std::to_string(t) +
+                                    " (its triangles are oriented clockwise seen from outside; re-orient them)"
+                              : "the surface overlaps itself near input triangle " + std::to_string(t) +
+                                    " (nested or intersecting shells: winding number " + std::to_string(wn) + ")");
+  };
+  out.untouched_winding.assign(w.begin() + nc, w.end());
+  w.resize(static_cast<std::size_t>(nc));
+  out.winding = std::move(w);
+  for (Index u = 0; u < nu; ++u) {
+    if (out.untouched_winding[u] == kUnset)
+      throw MeshingError(ErrorCode::kInternal, "classify", u, "untouched seed tet not reached");
+    Index t = -1;
+    for (int i = 0; i < 4; ++i)
+      if (ut.cover[u][i] >= 0) t = ut.cover[u][i];
+    check_winding(out.untouched_winding[u], t);
   }
   for (std::size_t c = 0; c < cells.size(); ++c) {
     if (!cells[c].alive) {
@@ -109,18 +164,10 @@ CellLabels classify_cells(BspComplex& bsp) {
     }
     if (out.winding[c] == kUnset)
       throw MeshingError(ErrorCode::kInternal, "classify", static_cast<std::int64_t>(c), "cell not reached");
-    if (out.winding[c] != 0 && out.winding[c] != 1) {
-      Index t = -1;
-      for (Index f : cells[c].faces)
-        if (out.coverage[f] != 0) t = blame(f);
-      throw InputError(out.winding[c] < 0 ? ErrorCode::kInwardFacing : ErrorCode::kSelfIntersection, "classify", t,
-                       out.winding[c] < 0
-                           ? "the surface faces inward near input triangle " + std::to_string(t) +
-                                 " (its triangles are oriented clockwise seen from outside; re-orient them)"
-                           : "the surface overlaps itself near input triangle " + std::to_string(t) +
-                                 " (nested or intersecting shells: winding number " +
-                                 std::to_string(out.winding[c]) + ")");
-    }
+    Index t = -1;
+    for (Index f : cells[c].faces)
+      if (out.coverage[f] != 0) t = blame(f);
+    check_winding(out.winding[c], t);
   }
   return out;
 }

@@ -122,14 +122,16 @@ std::array<Index, 4> tet_cell(const std::vector<BspFace>& faces, const BspCell& 
 }
 
 // Boundary faces: between an inside and an outside cell; outward is -n when the inside cell is on
-// the positive side.
+// the positive side. Then the untouched seed tets: the inside ones as they are, and their faces
+// towards the outside.
 template <class TrisOf>
-void boundary_faces(const std::vector<BspFace>& faces, const CellLabels& labels, TrisOf&& tris_of, CellTets& out) {
+void boundary_faces(const BspComplex& bsp, const CellLabels& labels, TrisOf&& tris_of, CellTets& out) {
+  const std::vector<BspFace>& faces = bsp.faces();
   for (std::size_t f = 0; f < faces.size(); ++f) {
     const BspFace& face = faces[f];
     if (!face.alive) continue;
-    const int w0 = face.cell[0] >= 0 ? labels.winding[face.cell[0]] : 0;
-    const int w1 = face.cell[1] >= 0 ? labels.winding[face.cell[1]] : 0;
+    const int w0 = labels.side_winding(bsp, static_cast<Index>(f), 0);
+    const int w1 = labels.side_winding(bsp, static_cast<Index>(f), 1);
     if (w0 == w1) continue;
     if (face.coplanar.empty() || labels.coverage[f] == 0)
       throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(f),
@@ -140,6 +142,25 @@ void boundary_faces(const std::vector<BspFace>& faces, const CellLabels& labels,
       else
         out.boundary.push_back(t);
       out.boundary_triangle.push_back(face.coplanar[0]);
+    }
+  }
+  const UntouchedSeedTets& ut = bsp.untouched();
+  for (std::size_t u = 0; u < ut.tets.size(); ++u) {
+    if (labels.untouched_winding[u] != 1) continue;
+    ++out.inside_cells;
+    const auto& t = ut.tets[u];
+    out.tets.push_back(t);
+    for (int i = 0; i < 4; ++i) {
+      const Index a = ut.adj[u][i];
+      if (a <= -2) continue;  // a complex face: done above
+      if ((a >= 0 ? labels.untouched_winding[a] : 0) == 1) continue;
+      if (ut.cover[u][i] < 0)
+        throw MeshingError(ErrorCode::kInternal, "tetrahedralize", static_cast<std::int64_t>(u),
+                           "a face between inside and outside is not covered by an input triangle");
+      // The face's normal in kTetOppositeFace order points into t (inside): outward reverses it.
+      const auto& fv = kTetOppositeFace[i];
+      out.boundary.push_back({t[fv[0]], t[fv[2]], t[fv[1]]});
+      out.boundary_triangle.push_back(ut.cover[u][i]);
     }
   }
 }
@@ -282,7 +303,7 @@ CellTets tetrahedralize_cells_cone(BspComplex& bsp, const CellLabels& labels) {
       }
     }
   }
-  boundary_faces(faces, labels, tris_of, out);
+  boundary_faces(bsp, labels, tris_of, out);
   return out;
 }
 
@@ -399,7 +420,7 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
     ++out.apex_cells;
     cone_cell(geo, faces, cells[c], ci, apex, false, tris_of, out);
   }
-  boundary_faces(faces, labels, tris_of, out);
+  boundary_faces(bsp, labels, tris_of, out);
   return out;
 }
 

@@ -79,8 +79,14 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    using Clock = std::chrono::steady_clock;
+    auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto t0 = Clock::now();
     SurfaceMesh s = read_off(argv[1]);
+    const double read_s = since(t0);
+    t0 = Clock::now();
     s.tri = check_surface(s, check).tri;
+    const double check_s = since(t0);
     MeshStats st;
     const TetMesh m = tetrahedralize(s, o, &st);
     MeshCheckReport r;
@@ -119,7 +125,9 @@ int main(int argc, char** argv) {
                   static_cast<long long>(st.steiner_removed_by_phase.at(phase)));
     std::printf("\n");
     for (const auto& msg : r.messages) std::printf("  %s\n", msg.c_str());
+    t0 = Clock::now();
     if (!stem.empty()) write_tetgen(stem, m);
+    std::printf("  program: read %.3f s  surface check %.3f s  write %.3f s\n", read_s, check_s, since(t0));
     return r.valid ? 0 : 1;
   } catch (const InputError& e) {
     std::printf("%s: INPUT ERROR %s\n", argv[1], e.what());

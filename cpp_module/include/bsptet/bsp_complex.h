@@ -87,6 +87,27 @@ struct BspCell {
   bool alive = true;
 };
 
+/// Seed tets kept out of the cell complex (BspSeed::kDelaunay, bsp_seed.cpp). A seed tet becomes a
+/// cell of the complex only when a split or a face refinement can reach it: when it shares an edge
+/// with a seed tet that an input triangle crosses, or with a seed face on an input plane that is
+/// not exactly one input triangle (refine_covered_faces would split it). Splits stay inside the
+/// closure of the crossed tets and refinements inside the closure of those faces, so they only
+/// cut edges that every tet around is in the complex for: an untouched tet stays a tet, and its
+/// faces shared with complex cells stay single triangles. Most seed tets of a fine surface are
+/// untouched; they skip the complex's faces, edge maps and per-cell passes.
+/// Adjacency of untouched tet t across the face opposite corner i (the face
+/// (tets[t][kTetOppositeFace[i][0..2]]), whose normal in that order points into t):
+///   adj >= 0: that untouched tet; adj == -1: outside the box; adj <= -2: complex face -2 - adj.
+/// step: the winding number across that face, neighbour's minus t's: 0 when no input triangle lies
+/// on the face; +1 when the input triangle on it has its outward normal pointing into t (t is
+/// outside there), -1 when pointing away (t inside). cover: that input triangle, or -1.
+struct UntouchedSeedTets {
+  std::vector<std::array<Index, 4>> tets;  ///< positive, vertex ids (input points and box corners)
+  std::vector<std::array<Index, 4>> adj;
+  std::vector<std::array<signed char, 4>> step;
+  std::vector<std::array<Index, 4>> cover;
+};
+
 /// What the complex starts from: one box cell (the paper: every input plane may cut it), or the
 /// tets of the Delaunay tetrahedralization of the input points and the box corners (bsp_seed.cpp:
 /// only the cells an input triangle actually crosses are split).
@@ -94,6 +115,7 @@ enum class BspSeed { kBox, kDelaunay };
 
 struct BspStats {
   std::int64_t seed_tets = 0;       ///< cells the complex started from beside the box (BspSeed::kDelaunay)
+  std::int64_t untouched_tets = 0;  ///< of the seed tets, those kept out of the complex (UntouchedSeedTets)
   std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs after seeding
   std::int64_t seed_faces_relabelled = 0;  ///< seed faces found on an input plane only by the walk
   std::int64_t seed_missing_edges = 0;    ///< input edges not in the Delaunay seed
@@ -163,6 +185,13 @@ class BspComplex {
   void refine_covered_faces_along_lines();
 
   const std::vector<BspFace>& faces() const { return faces_; }
+  /// Seed tets kept out of the complex (empty unless seeded by BspSeed::kDelaunay).
+  const UntouchedSeedTets& untouched() const { return untouched_; }
+  /// The untouched seed tet on the side of complex face f whose cell is -1, or -1 (outside the
+  /// box, or no such side).
+  Index face_untouched(Index f) const {
+    return static_cast<std::size_t>(f) < face_untouched_.size() ? face_untouched_[f] : -1;
+  }
   const std::vector<BspCell>& cells() const { return cells_; }
   const BspStats& stats() const { return stats_; }
   ImplicitGeometry& geometry() { return geo_; }
@@ -242,6 +271,8 @@ class BspComplex {
   std::unordered_map<std::uint64_t, std::vector<Index>> edge_faces_;
   std::unordered_map<std::uint64_t, std::array<Index, 2>> edge_line_;
   BspStats stats_;
+  UntouchedSeedTets untouched_;
+  std::vector<Index> face_untouched_;  ///< per seed face of the complex (see face_untouched)
   bool debug_checks_ = false;
   Index corner0_ = -1;  ///< vertex id of the first box corner
 };
