@@ -907,10 +907,21 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   }
   cells_.assign(static_cast<std::size_t>(num_cells), BspCell{});
   std::vector<Index> complex_face(sfaces.size(), -1);
+  // In the order of their sorted corners (the refinements visit faces by id: a fixed order that
+  // does not depend on how the seed's tets were numbered).
+  std::vector<std::pair<std::array<Index, 3>, Index>> made;
   for (std::size_t i = 0; i < sfaces.size(); ++i) {
+    const SeedFace& f = sfaces[i];
+    if ((f.tet[0] >= 0 && cell_of[f.tet[0]] >= 0) || (f.tet[1] >= 0 && cell_of[f.tet[1]] >= 0)) {
+      std::array<Index, 3> key = f.verts;
+      std::sort(key.begin(), key.end());
+      made.push_back({key, static_cast<Index>(i)});
+    }
+  }
+  std::sort(made.begin(), made.end());
+  for (const auto& [key, i] : made) {
     SeedFace& f = sfaces[i];
     const Index c0 = f.tet[0] >= 0 ? cell_of[f.tet[0]] : -1, c1 = f.tet[1] >= 0 ? cell_of[f.tet[1]] : -1;
-    if (c0 < 0 && c1 < 0) continue;
     BspFace bf;
     bf.plane = f.plane >= 0 ? f.plane
                             : geo_.add_plane(geo_.explicit_id(f.verts[0]), geo_.explicit_id(f.verts[1]),
@@ -939,8 +950,13 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   untouched_.adj.reserve(static_cast<std::size_t>(num_untouched));
   untouched_.step.reserve(static_cast<std::size_t>(num_untouched));
   untouched_.cover.reserve(static_cast<std::size_t>(num_untouched));
+  untouched_.before_cell.reserve(static_cast<std::size_t>(num_untouched));
+  Index cells_before = 0;
   for (Index t = 0; t < nt; ++t) {
-    if (untouched_of[t] < 0) continue;
+    if (untouched_of[t] < 0) {
+      ++cells_before;
+      continue;
+    }
     std::array<Index, 4> adj, cover{{-1, -1, -1, -1}};
     std::array<signed char, 4> step{{0, 0, 0, 0}};
     for (int i = 0; i < 4; ++i) {
@@ -962,6 +978,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       cover[i] = tr;
     }
     untouched_.tets.push_back(tets[t]);
+    untouched_.before_cell.push_back(cells_before);
     untouched_.adj.push_back(adj);
     untouched_.step.push_back(step);
     untouched_.cover.push_back(cover);

@@ -121,6 +121,31 @@ std::array<Index, 4> tet_cell(const std::vector<BspFace>& faces, const BspCell& 
   return {t[0], t[2], t[1], d};
 }
 
+// The inside untouched seed tets, output in seed order among the cells' tets: call before(c)
+// before cell c's tets, and rest() after the last cell.
+class UntouchedOutput {
+ public:
+  UntouchedOutput(const BspComplex& bsp, const CellLabels& labels, CellTets& out)
+      : ut_(bsp.untouched()), labels_(labels), out_(out) {}
+  void before(std::size_t c) {
+    while (next_ < ut_.tets.size() && static_cast<std::size_t>(ut_.before_cell[next_]) <= c) emit(next_++);
+  }
+  void rest() {
+    while (next_ < ut_.tets.size()) emit(next_++);
+  }
+
+ private:
+  void emit(std::size_t u) {
+    if (labels_.untouched_winding[u] != 1) return;
+    ++out_.inside_cells;
+    out_.tets.push_back(ut_.tets[u]);
+  }
+  const UntouchedSeedTets& ut_;
+  const CellLabels& labels_;
+  CellTets& out_;
+  std::size_t next_ = 0;
+};
+
 // Boundary faces: between an inside and an outside cell; outward is -n when the inside cell is on
 // the positive side. Then the untouched seed tets: the inside ones as they are, and their faces
 // towards the outside.
@@ -147,9 +172,7 @@ void boundary_faces(const BspComplex& bsp, const CellLabels& labels, TrisOf&& tr
   const UntouchedSeedTets& ut = bsp.untouched();
   for (std::size_t u = 0; u < ut.tets.size(); ++u) {
     if (labels.untouched_winding[u] != 1) continue;
-    ++out.inside_cells;
     const auto& t = ut.tets[u];
-    out.tets.push_back(t);
     for (int i = 0; i < 4; ++i) {
       const Index a = ut.adj[u][i];
       if (a <= -2) continue;  // a complex face: done above
@@ -270,7 +293,9 @@ CellTets tetrahedralize_cells_cone(BspComplex& bsp, const CellLabels& labels) {
     }
     return face_tris[f];
   };
+  UntouchedOutput untouched(bsp, labels, out);
   for (std::size_t c = 0; c < cells.size(); ++c) {
+    untouched.before(c);
     if (kind[c] == 0) continue;
     if (kind[c] == 1) {
       // The cell is a tetrahedron (a convex cell with four vertices has four triangular faces and
@@ -303,6 +328,7 @@ CellTets tetrahedralize_cells_cone(BspComplex& bsp, const CellLabels& labels) {
       }
     }
   }
+  untouched.rest();
   boundary_faces(bsp, labels, tris_of, out);
   return out;
 }
@@ -341,7 +367,9 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
   std::vector<std::array<Index, 3>> want;
   std::vector<Index> cell_planes;
   std::vector<std::pair<std::array<Index, 3>, Index>> want_planes;
+  UntouchedOutput untouched(bsp, labels, out);
   for (std::size_t c = 0; c < cells.size(); ++c) {
+    untouched.before(c);
     if (!cells[c].alive || labels.winding[c] != 1) continue;
     ++out.inside_cells;
     const Index ci = static_cast<Index>(c);
@@ -420,6 +448,7 @@ CellTets tetrahedralize_cells_delaunay(BspComplex& bsp, const CellLabels& labels
     ++out.apex_cells;
     cone_cell(geo, faces, cells[c], ci, apex, false, tris_of, out);
   }
+  untouched.rest();
   boundary_faces(bsp, labels, tris_of, out);
   return out;
 }

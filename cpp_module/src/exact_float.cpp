@@ -36,6 +36,22 @@ mpq_class ExactFloat::to_mpq() const {
   return q;
 }
 
+double ExactFloat::truncated_quotient(const ExactFloat& den) const {
+  mpq_t q;
+  mpq_init(q);
+  // (m1 2^e1) / (m2 2^e2): the power of two on the side that keeps both integers.
+  const std::int64_t shift = exp_ - den.exp_;
+  mpz_mul_2exp(mpq_numref(q), mant_.get_mpz_t(), static_cast<mp_bitcnt_t>(shift > 0 ? shift : 0));
+  mpz_mul_2exp(mpq_denref(q), den.mant_.get_mpz_t(), static_cast<mp_bitcnt_t>(shift < 0 ? -shift : 0));
+  if (mpz_sgn(mpq_denref(q)) < 0) {
+    mpz_neg(mpq_numref(q), mpq_numref(q));
+    mpz_neg(mpq_denref(q), mpq_denref(q));
+  }
+  const double d = mpq_get_d(q);  // truncates; needs no reduced fraction
+  mpq_clear(q);
+  return d;
+}
+
 // Sum or difference without temporaries: the operand with the larger exponent is shifted into the
 // result's mantissa, then the other is added or subtracted in place (one allocation at most).
 ExactFloat add_or_subtract(const ExactFloat& a, const ExactFloat& b, bool subtract) {

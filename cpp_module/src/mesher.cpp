@@ -49,13 +49,28 @@ SurfaceMesh merge_coincident_points(const SurfaceMesh& in) {
 }
 
 // Groups the triangles by exact plane: a canonical rational key (the plane equation divided by
-// its first non-zero normal component) finds candidates, an exact orientation test confirms.
+// its first non-zero normal component, each entry truncated to a double: a function of the exact
+// values alone) finds candidates, an exact orientation test confirms. A triangle sharing an edge
+// with one of the plane's triangles and exactly coplanar with it joins that plane without a key
+// (a planar CAD face is one key, not one per triangle).
 std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
   const Index nt = s.num_triangles();
   std::vector<Index> tri_plane(nt, -1);
+  // Each undirected edge's two triangles (a closed surface: validated before).
+  std::vector<std::pair<std::uint64_t, Index>> edge_tri;
+  edge_tri.reserve(3 * static_cast<std::size_t>(nt));
+  for (Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      Index u = s.tri[3 * t + k], w = s.tri[3 * t + (k + 1) % 3];
+      if (u > w) std::swap(u, w);
+      edge_tri.push_back({(static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w), t});
+    }
+  std::sort(edge_tri.begin(), edge_tri.end());
   std::map<std::array<double, 4>, std::vector<std::pair<Index, Index>>> buckets;  // key -> (plane, tri)
-  for (Index t = 0; t < nt; ++t) {
-    const Index a = s.tri[3 * t], b = s.tri[3 * t + 1], c = s.tri[3 * t + 2];
+  std::vector<Index> patch;
+  for (Index t0 = 0; t0 < nt; ++t0) {
+    if (tri_plane[t0] >= 0) continue;
+    const Index a = s.tri[3 * t0], b = s.tri[3 * t0 + 1], c = s.tri[3 * t0 + 2];
     const Vec3 pa = s.point(a), pb = s.point(b), pc = s.point(c);
     const ExactFloat ax(pa.x), ay(pa.y), az(pa.z);
     const ExactFloat ux = ExactFloat(pb.x) - ax, uy = ExactFloat(pb.y) - ay, uz = ExactFloat(pb.z) - az;
@@ -64,10 +79,9 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     const ExactFloat d = n[0] * ax + n[1] * ay + n[2] * az;
     int k = 0;
     while (k < 3 && n[k].sign() == 0) ++k;
-    const mpq_class nk = n[k].to_mpq();
     std::array<double, 4> key;
-    for (int i = 0; i < 3; ++i) key[i] = mpq_class(n[i].to_mpq() / nk).get_d();
-    key[3] = mpq_class(d.to_mpq() / nk).get_d();
+    for (int i = 0; i < 3; ++i) key[i] = n[i].truncated_quotient(n[k]);
+    key[3] = d.truncated_quotient(n[k]);
     auto& bucket = buckets[key];
     Index plane = -1;
     for (const auto& [p, rep] : bucket) {
@@ -80,9 +94,32 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     }
     if (plane < 0) {
       plane = geo.add_plane(a, b, c);
-      bucket.emplace_back(plane, t);
+      bucket.emplace_back(plane, t0);
     }
-    tri_plane[t] = plane;
+    // The edge-connected triangles exactly on t0's plane.
+    tri_plane[t0] = plane;
+    patch.assign(1, t0);
+    for (std::size_t h = 0; h < patch.size(); ++h) {
+      const Index t = patch[h];
+      for (int e = 0; e < 3; ++e) {
+        Index u = s.tri[3 * t + e], w = s.tri[3 * t + (e + 1) % 3];
+        if (u > w) std::swap(u, w);
+        const std::uint64_t key2 = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
+        for (auto it = std::lower_bound(edge_tri.begin(), edge_tri.end(), std::pair<std::uint64_t, Index>{key2, -1});
+             it != edge_tri.end() && it->first == key2; ++it) {
+          const Index o = it->second;
+          if (tri_plane[o] >= 0) continue;
+          bool on = true;
+          for (int j = 0; j < 3 && on; ++j) {
+            const Index x = s.tri[3 * o + j];
+            on = x == u || x == w || orient3d(pa, pb, pc, s.point(x)) == Sign::kZero;
+          }
+          if (!on) continue;
+          tri_plane[o] = plane;
+          patch.push_back(o);
+        }
+      }
+    }
   }
   return tri_plane;
 }

@@ -25,6 +25,8 @@ std::uint64_t splitmix(std::uint64_t& s) {
 class Builder {
  public:
   Builder(ImplicitGeometry& geo, const std::vector<Index>& order) : geo_(geo), ids_(order) {
+    std::uint64_t s = 0x5eedULL;  // the walk's face order: delaunay_points' generator
+    rng_ = splitmix(s);
     pts_.reserve(order.size());
     for (Index v : order) pts_.push_back(geo.explicit_point(geo.explicit_id(v)));
     const std::size_t cap = 7 * order.size() + 64;
@@ -263,7 +265,7 @@ class Builder {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> edges_;
   std::uint32_t stamp_ = 0;
   int hint_ = 0;
-  std::uint64_t rng_ = 0x5eedULL;
+  std::uint64_t rng_ = 0;
 };
 
 }  // namespace

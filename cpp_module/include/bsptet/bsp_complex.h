@@ -106,6 +106,10 @@ struct UntouchedSeedTets {
   std::vector<std::array<Index, 4>> adj;
   std::vector<std::array<signed char, 4>> step;
   std::vector<std::array<Index, 4>> cover;
+  /// Complex cells made from seed tets before this one (cells are numbered in seed order, split
+  /// products after them): an untouched tet goes out just before cell before_cell[u] (or after
+  /// the last seed cell), so the output keeps the seed's order whatever was left out.
+  std::vector<Index> before_cell;
 };
 
 /// What the complex starts from: one box cell (the paper: every input plane may cut it), or the

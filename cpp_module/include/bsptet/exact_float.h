@@ -21,6 +21,9 @@ class ExactFloat {
   double to_double() const;
   /// The exact value as a GMP rational.
   mpq_class to_mpq() const;
+  /// *this / den truncated towards zero to a double (den nonzero): a function of the two exact
+  /// values alone, computed without reducing the fraction (for canonical keys, never to decide).
+  double truncated_quotient(const ExactFloat& den) const;
 
   friend ExactFloat operator+(const ExactFloat& a, const ExactFloat& b);
   friend ExactFloat operator-(const ExactFloat& a, const ExactFloat& b);
