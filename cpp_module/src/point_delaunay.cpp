@@ -236,16 +236,7 @@ class Builder {
       }
       if (v[3] != kInf) last_real = id;
     }
-    std::sort(edges_.begin(), edges_.end());
-    if (edges_.size() % 2) return false;
-    for (std::size_t j = 0; j < edges_.size(); j += 2) {
-      if (edges_[j].first != edges_[j + 1].first || (j + 2 < edges_.size() && edges_[j + 2].first == edges_[j].first))
-        return false;
-      const int ta = static_cast<int>(edges_[j].second >> 2), ka = static_cast<int>(edges_[j].second & 3);
-      const int tb = static_cast<int>(edges_[j + 1].second >> 2), kb = static_cast<int>(edges_[j + 1].second & 3);
-      nb_[ta][ka] = tb;
-      nb_[tb][kb] = ta;
-    }
+    if (!link_new_tets()) return false;
     for (int t : cavity_) {
       v_[t][0] = kDead;
       free_.push_back(t);
@@ -254,6 +245,58 @@ class Builder {
     return true;
   }
 
+  // Pairs the new tets' faces listed in edges_ (each edge key twice). A small open-addressing
+  // table with generation stamps (no clearing, no allocation); a sort for a huge cavity.
+  bool link_new_tets() {
+    auto join = [&](std::uint64_t a, std::uint64_t b) {
+      const int ta = static_cast<int>(a >> 2), ka = static_cast<int>(a & 3);
+      const int tb = static_cast<int>(b >> 2), kb = static_cast<int>(b & 3);
+      nb_[ta][ka] = tb;
+      nb_[tb][kb] = ta;
+    };
+    if (edges_.size() % 2) return false;
+    if (2 * edges_.size() > kTable) {
+      std::sort(edges_.begin(), edges_.end());
+      for (std::size_t j = 0; j < edges_.size(); j += 2) {
+        if (edges_[j].first != edges_[j + 1].first || (j + 2 < edges_.size() && edges_[j + 2].first == edges_[j].first))
+          return false;
+        join(edges_[j].second, edges_[j + 1].second);
+      }
+      return true;
+    }
+    if (++gen_ == 0) {
+      table_gen_.fill(0);
+      gen_ = 1;
+    }
+    std::size_t open = 0;
+    for (const auto& [key, val] : edges_) {
+      std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ULL) >> 55) & (kTable - 1);
+      for (;;) {
+        if (table_gen_[h] != gen_) {  // empty: the first of the pair
+          table_gen_[h] = gen_;
+          table_key_[h] = key;
+          table_val_[h] = val;
+          ++open;
+          break;
+        }
+        if (table_key_[h] == key && table_val_[h] != kPaired) {
+          join(table_val_[h], val);
+          table_val_[h] = kPaired;
+          --open;
+          break;
+        }
+        if (table_key_[h] == key) return false;  // a third face on one edge
+        h = (h + 1) & (kTable - 1);
+      }
+    }
+    return open == 0;
+  }
+
+  static constexpr std::size_t kTable = 512;
+  static constexpr std::uint64_t kPaired = ~std::uint64_t(0);
+  std::array<std::uint32_t, kTable> table_gen_{};
+  std::array<std::uint64_t, kTable> table_key_{}, table_val_{};
+  std::uint32_t gen_ = 0;
   static constexpr int kDead = -2;
   ImplicitGeometry& geo_;
   std::vector<Index> ids_;

@@ -93,7 +93,7 @@ TEST(Orient3d, ExpansionsAgreeWithExactFloat) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(-1, 1);
   std::uniform_int_distribution<int> scale_exp(-150, 150);
-  int zeros = 0, nonzeros = 0, refused = 0;
+  int zeros = 0, nonzeros = 0, refused = 0, by_differences = 0;
   for (int it = 0; it < 100000; ++it) {
     const double s = std::ldexp(1.0, scale_exp(rng));
     const double shift = (it % 5 == 0) ? 1e7 * s : 0.0;
@@ -117,21 +117,31 @@ TEST(Orient3d, ExpansionsAgreeWithExactFloat) {
       }
       if (it % 3 == 2) p[3].y = std::nextafter(p[3].y, (it & 8) ? INFINITY : -INFINITY);
     }
-    Sign got;
+    Sign got, from_differences;
+    const Sign want = orient3d_exact(p[0], p[1], p[2], p[3]);
+    if (orient3d_differences_expansion(p[0], p[1], p[2], p[3], from_differences)) {
+      ASSERT_EQ(from_differences, want) << "differences, iteration " << it << " seed " << seed;
+      ++by_differences;
+    }
     if (!orient3d_expansion(p[0], p[1], p[2], p[3], got)) {
       ++refused;
       continue;
     }
-    const Sign want = orient3d_exact(p[0], p[1], p[2], p[3]);
     ASSERT_EQ(got, want) << "iteration " << it << " seed " << seed;
     (want == Sign::kZero ? zeros : nonzeros) += 1;
   }
+  // The differences stage decides most of these (exact differences: no shift, or a shift
+  // within Sterbenz's range), and is exact on every one it decides.
+  EXPECT_GT(by_differences, 30000);
   EXPECT_GT(zeros, 10000);
   EXPECT_GT(nonzeros, 10000);
   EXPECT_LT(refused, 100);  // a subnormal coordinate (the ulp step off 0), refused by design
   Sign out;
   EXPECT_FALSE(orient3d_expansion({1e-70, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
   EXPECT_FALSE(orient3d_expansion({1e70, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
+  EXPECT_FALSE(orient3d_differences_expansion({1e-70, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
+  EXPECT_FALSE(orient3d_differences_expansion({0, 0, 0}, {1e70, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));
+  EXPECT_FALSE(orient3d_differences_expansion({1, 0, 0}, {0x1p-60, 0, 0}, {0, 1, 0}, {0, 0, 1}, out));  // 1 - 2^-60 not exact
 }
 
 TEST(Orient3d, ExtremeMagnitudes) {

@@ -33,6 +33,10 @@ Sign orient2d_projected_exact(const Vec3& a, const Vec3& b, const Vec3& c, int a
 /// filter fails); false, and `out` unset, when a nonzero coordinate's magnitude is outside
 /// [2^-200, 2^200] (orient3d then uses orient3d_exact).
 bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
+/// The exact sign of orient3d by expansions of the differences b - a, c - a, d - a (tried before
+/// orient3d_expansion: far cheaper); false, and `out` unset, when a difference is not exact in
+/// doubles or a nonzero one's magnitude is outside [2^-200, 2^200].
+bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
 
 /// Filters for points known only approximately: each exact point lies within r (per coordinate)
 /// of the given double point (a TPI vertex's rounded coordinates and its enclosing box). True,
