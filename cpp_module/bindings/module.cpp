@@ -180,6 +180,7 @@ PYBIND11_MODULE(_bsptet, m) {
         d["inside_cells"] = st.inside_cells;
         d["bsp_points"] = st.bsp_points;
         d["seed_tets"] = st.seed_tets;
+        d["seed_untouched_tets"] = st.seed_untouched_tets;
         d["seed_conflicts"] = st.seed_conflicts;
         d["seed_fell_back"] = st.seed_fell_back;
         d["seed_faces_relabelled"] = st.seed_faces_relabelled;

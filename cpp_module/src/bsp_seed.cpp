@@ -679,7 +679,33 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   std::vector<std::array<Index, 4>> tets = std::move(dt.tets);
   std::vector<std::array<Index, 4>> nb = std::move(dt.nb);
   lap("seed_delaunay");
+  // Is any input edge or input triangle missing from the seed? (Vertex -> tets incidence in one
+  // array; flips never remove an input edge or triangle, so what is here now stays.) When nothing
+  // is missing, the flips' bookkeeping is not built at all.
+  bool all_present = true;
   {
+    const std::size_t nv = static_cast<std::size_t>(corner0_ + 8);
+    std::vector<Index> first(nv + 1, 0), inc(4 * tets.size());
+    for (const auto& q : tets)
+      for (Index v : q) ++first[v + 1];
+    for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+    std::vector<Index> fill(first.begin(), first.end() - 1);
+    for (std::size_t t = 0; t < tets.size(); ++t)
+      for (Index v : tets[t]) inc[fill[v]++] = static_cast<Index>(t);
+    auto has = [&](Index a, Index b, Index c) {  // c < 0: edge (a, b)
+      for (Index i = first[a]; i < first[a + 1]; ++i) {
+        const auto& q = tets[inc[i]];
+        const bool hb = q[0] == b || q[1] == b || q[2] == b || q[3] == b;
+        if (hb && (c < 0 || q[0] == c || q[1] == c || q[2] == c || q[3] == c)) return true;
+      }
+      return false;
+    };
+    for (Index tr = 0; tr < surface_.num_triangles() && all_present; ++tr) {
+      const Index a = triangle_vertex(tr, 0), b = triangle_vertex(tr, 1), c = triangle_vertex(tr, 2);
+      all_present = has(a, b, -1) && has(b, c, -1) && has(c, a, -1) && has(a, b, c);
+    }
+  }
+  if (!all_present) {
     SeedFlips flips(tets, corner0_ + 8, point_of);
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
       flips.protect_triangle(triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2));

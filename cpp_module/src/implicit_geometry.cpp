@@ -69,7 +69,11 @@ Sign to_sign(int s) { return s > 0 ? Sign::kPositive : (s < 0 ? Sign::kNegative 
 
 }  // namespace
 
-ImplicitGeometry::ImplicitGeometry(std::vector<Vec3> explicit_points) : points_(std::move(explicit_points)) {}
+ImplicitGeometry::ImplicitGeometry(std::vector<Vec3> explicit_points) : points_(std::move(explicit_points)) {
+  // Every explicit point usually becomes a vertex, and the BSP adds about as many: no regrowth of
+  // the (large) vertex records on the way.
+  verts_.reserve(2 * points_.size() + 16);
+}
 
 Index ImplicitGeometry::add_plane(Index a, Index b, Index c) {
   const Index id = static_cast<Index>(planes_.size());

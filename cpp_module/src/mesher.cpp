@@ -34,17 +34,29 @@ std::string tri_str(const SurfaceMesh& s, Index t) {
          std::to_string(s.tri[3 * t + 1]) + " " + std::to_string(s.tri[3 * t + 2]) + ")";
 }
 
-// Merges input points with identical coordinates (first index wins); returns the surface with
-// canonical indices.
+// Merges input points with identical coordinates (first index wins; -0.0 equals 0.0); returns the
+// surface with canonical indices. By sorting, not a tree of keys.
 SurfaceMesh merge_coincident_points(const SurfaceMesh& in) {
-  std::map<std::array<double, 3>, Index> first;
-  std::vector<Index> canon(in.num_points());
-  for (Index i = 0; i < in.num_points(); ++i) {
-    std::array<double, 3> key = {in.xyz[3 * i] + 0.0, in.xyz[3 * i + 1] + 0.0, in.xyz[3 * i + 2] + 0.0};
-    canon[i] = first.emplace(key, i).first->second;
+  const Index np = in.num_points();
+  std::vector<Index> order(static_cast<std::size_t>(np));
+  for (Index i = 0; i < np; ++i) order[i] = i;
+  auto coords = [&](Index i) {
+    return std::array<double, 3>{in.xyz[3 * i] + 0.0, in.xyz[3 * i + 1] + 0.0, in.xyz[3 * i + 2] + 0.0};
+  };
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+    const auto ca = coords(a), cb = coords(b);
+    return ca != cb ? ca < cb : a < b;
+  });
+  std::vector<Index> canon(static_cast<std::size_t>(np));
+  bool merged = false;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool same = k > 0 && coords(order[k]) == coords(order[k - 1]);
+    canon[order[k]] = same ? canon[order[k - 1]] : order[k];
+    merged = merged || same;
   }
   SurfaceMesh out = in;
-  for (auto& v : out.tri) v = canon[v];
+  if (merged)
+    for (auto& v : out.tri) v = canon[v];
   return out;
 }
 
@@ -56,17 +68,45 @@ SurfaceMesh merge_coincident_points(const SurfaceMesh& in) {
 std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
   const Index nt = s.num_triangles();
   std::vector<Index> tri_plane(nt, -1);
-  // Each undirected edge's two triangles (a closed surface: validated before).
-  std::vector<std::pair<std::uint64_t, Index>> edge_tri;
+  // The triangles across each edge: slot 3t + e (edge e of t) -> the run of edge_tri holding
+  // every slot on the same undirected edge (two on a closed manifold surface).
+  std::vector<std::pair<std::uint64_t, Index>> edge_tri;  // (edge key, slot)
   edge_tri.reserve(3 * static_cast<std::size_t>(nt));
   for (Index t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       Index u = s.tri[3 * t + k], w = s.tri[3 * t + (k + 1) % 3];
       if (u > w) std::swap(u, w);
-      edge_tri.push_back({(static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w), t});
+      edge_tri.push_back({(static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w),
+                          3 * t + k});
     }
   std::sort(edge_tri.begin(), edge_tri.end());
-  std::map<std::array<double, 4>, std::vector<std::pair<Index, Index>>> buckets;  // key -> (plane, tri)
+  std::vector<std::pair<Index, Index>> run_of(3 * static_cast<std::size_t>(nt));  // [begin, end) in edge_tri
+  for (std::size_t i = 0; i < edge_tri.size();) {
+    std::size_t j = i;
+    while (j < edge_tri.size() && edge_tri[j].first == edge_tri[i].first) ++j;
+    for (std::size_t k = i; k < j; ++k) run_of[edge_tri[k].second] = {static_cast<Index>(i), static_cast<Index>(j)};
+    i = j;
+  }
+  struct KeyHash {
+    std::size_t operator()(const std::array<double, 4>& k) const {
+      std::uint64_t h = 0x9E3779B97F4A7C15ULL;
+      for (double d : k) {
+        std::uint64_t bits;
+        const double z = d + 0.0;  // -0.0 hashes as 0.0
+        std::memcpy(&bits, &z, sizeof bits);
+        h = (h ^ bits) * 0x100000001B3ULL;
+        h ^= h >> 29;
+      }
+      return static_cast<std::size_t>(h);
+    }
+  };
+  // key -> first entry of its chain in `reps` (plane, representative triangle, next entry or -1).
+  std::unordered_map<std::array<double, 4>, Index, KeyHash> buckets;
+  buckets.reserve(static_cast<std::size_t>(nt));
+  struct Rep {
+    Index plane, tri, next;
+  };
+  std::vector<Rep> reps;
   std::vector<Index> patch;
   for (Index t0 = 0; t0 < nt; ++t0) {
     if (tri_plane[t0] >= 0) continue;
@@ -82,19 +122,27 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     std::array<double, 4> key;
     for (int i = 0; i < 3; ++i) key[i] = n[i].truncated_quotient(n[k]);
     key[3] = d.truncated_quotient(n[k]);
-    auto& bucket = buckets[key];
+    const auto [slot, fresh] = buckets.try_emplace(key, -1);
     Index plane = -1;
-    for (const auto& [p, rep] : bucket) {
+    for (Index r = slot->second; r >= 0 && plane < 0; r = reps[r].next) {
+      const Index rep = reps[r].tri;
       const Vec3 ra = s.point(s.tri[3 * rep]), rb = s.point(s.tri[3 * rep + 1]), rc = s.point(s.tri[3 * rep + 2]);
       if (orient3d(ra, rb, rc, pa) == Sign::kZero && orient3d(ra, rb, rc, pb) == Sign::kZero &&
-          orient3d(ra, rb, rc, pc) == Sign::kZero) {
-        plane = p;
-        break;
-      }
+          orient3d(ra, rb, rc, pc) == Sign::kZero)
+        plane = reps[r].plane;
     }
     if (plane < 0) {
       plane = geo.add_plane(a, b, c);
-      bucket.emplace_back(plane, t0);
+      // Appended at the chain's end (the order the old per-key lists kept).
+      const Index id = static_cast<Index>(reps.size());
+      reps.push_back({plane, t0, -1});
+      if (slot->second < 0) {
+        slot->second = id;
+      } else {
+        Index r = slot->second;
+        while (reps[r].next >= 0) r = reps[r].next;
+        reps[r].next = id;
+      }
     }
     // The edge-connected triangles exactly on t0's plane.
     tri_plane[t0] = plane;
@@ -102,12 +150,10 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     for (std::size_t h = 0; h < patch.size(); ++h) {
       const Index t = patch[h];
       for (int e = 0; e < 3; ++e) {
-        Index u = s.tri[3 * t + e], w = s.tri[3 * t + (e + 1) % 3];
-        if (u > w) std::swap(u, w);
-        const std::uint64_t key2 = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
-        for (auto it = std::lower_bound(edge_tri.begin(), edge_tri.end(), std::pair<std::uint64_t, Index>{key2, -1});
-             it != edge_tri.end() && it->first == key2; ++it) {
-          const Index o = it->second;
+        const Index u = s.tri[3 * t + e], w = s.tri[3 * t + (e + 1) % 3];
+        const auto [rb, re] = run_of[3 * t + e];
+        for (Index r = rb; r < re; ++r) {
+          const Index o = edge_tri[r].second / 3;
           if (tri_plane[o] >= 0) continue;
           bool on = true;
           for (int j = 0; j < 3 && on; ++j) {
@@ -147,8 +193,23 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
                          "triangle " + std::to_string(t) + " refers to vertex " + std::to_string(s.tri[3 * t + k]) +
                              ", out of range [0, " + std::to_string(np) + ")");
   const SurfaceMesh m = merge_coincident_points(s);
-  std::map<std::array<Index, 3>, Index> seen;
-  std::unordered_map<std::uint64_t, std::pair<int, Index>> directed;  // (count, a triangle)
+  // The first triangle (in input order) on the same three vertices as an earlier one.
+  Index dup = -1, of = -1;
+  {
+    std::vector<std::pair<std::array<Index, 3>, Index>> keys(static_cast<std::size_t>(nt));
+    for (Index t = 0; t < nt; ++t) {
+      std::array<Index, 3> k = {m.tri[3 * t], m.tri[3 * t + 1], m.tri[3 * t + 2]};
+      std::sort(k.begin(), k.end());
+      keys[t] = {k, t};
+    }
+    std::sort(keys.begin(), keys.end());
+    for (std::size_t i = 1; i < keys.size(); ++i)
+      if (keys[i].first == keys[i - 1].first && (i < 2 || keys[i - 2].first != keys[i].first) &&
+          (dup < 0 || keys[i].second < dup)) {
+        dup = keys[i].second;
+        of = keys[i - 1].second;
+      }
+  }
   for (Index t = 0; t < nt; ++t) {
     const Index a = m.tri[3 * t], b = m.tri[3 * t + 1], c = m.tri[3 * t + 2];
     const Vec3 pa = m.point(a), pb = m.point(b), pc = m.point(c);
@@ -157,29 +218,35 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
          orient2d_projected(pa, pb, pc, 2) == Sign::kZero))
       throw InputError(ErrorCode::kDegenerateTriangle, "input", t,
                        tri_str(s, t) + " is degenerate (zero area); remove it or repair the surface");
-    std::array<Index, 3> key = {a, b, c};
-    std::sort(key.begin(), key.end());
-    auto ins = seen.emplace(key, t);
-    if (!ins.second)
-      throw InputError(ErrorCode::kDuplicateTriangle, "input", t,
-                       tri_str(s, t) + " duplicates triangle " + std::to_string(ins.first->second));
-    const Index v[3] = {a, b, c};
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t e = (static_cast<std::uint64_t>(v[k]) << 32) | static_cast<std::uint32_t>(v[(k + 1) % 3]);
-      auto& d = directed[e];
-      d.first++;
-      d.second = t;
-    }
+    if (t == dup)
+      throw InputError(ErrorCode::kDuplicateTriangle, "input", dup,
+                       tri_str(s, dup) + " duplicates triangle " + std::to_string(of));
   }
-  std::vector<std::uint64_t> keys;
-  keys.reserve(directed.size());
-  for (const auto& kv : directed) keys.push_back(kv.first);
-  std::sort(keys.begin(), keys.end());  // deterministic first error
-  for (std::uint64_t e : keys) {
-    const auto& [count, t] = directed[e];
-    const std::uint64_t rev = (e << 32) | (e >> 32);
-    auto it = directed.find(rev);
-    const int back = it == directed.end() ? 0 : it->second.first;
+  // Directed edges (u << 32 | v) with their triangles, sorted: each must be matched by as many
+  // uses of (v, u). The first failing edge in key order is reported.
+  std::vector<std::pair<std::uint64_t, Index>> directed;
+  directed.reserve(3 * static_cast<std::size_t>(nt));
+  for (Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      directed.push_back({(static_cast<std::uint64_t>(m.tri[3 * t + k]) << 32) |
+                              static_cast<std::uint32_t>(m.tri[3 * t + (k + 1) % 3]),
+                          t});
+  std::sort(directed.begin(), directed.end());
+  auto uses = [&](std::uint64_t e) {
+    const auto lo = std::lower_bound(directed.begin(), directed.end(), std::pair<std::uint64_t, Index>{e, -1});
+    std::size_t n = 0;
+    for (auto it = lo; it != directed.end() && it->first == e; ++it) ++n;
+    return n;
+  };
+  for (std::size_t i = 0; i < directed.size();) {
+    std::size_t j = i;
+    while (j < directed.size() && directed[j].first == directed[i].first) ++j;
+    const std::uint64_t e = directed[i].first;
+    const std::size_t count = j - i;
+    const Index t = directed[j - 1].second;  // the last triangle using it
+    const std::size_t back = uses((e << 32) | (e >> 32));
+    i = j;
+    if (back == count) continue;
     const std::string edge = "(" + std::to_string(e >> 32) + " " + std::to_string(e & 0xffffffffu) + ")";
     if (back == 0 && count == 1)
       throw InputError(ErrorCode::kOpenBoundary, "input", t,
@@ -254,6 +321,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
     complex = std::make_unique<BspComplex>(geo, surface, tri_plane, BspSeed::kBox);
   }
   st.delaunay_seeded = complex->stats().seed_tets > 0 ? 1 : 0;
+  st.seed_untouched_tets = complex->stats().untouched_tets;
   st.seed_faces_relabelled = complex->stats().seed_faces_relabelled;
   if (seeded) *seeded = st.delaunay_seeded != 0;
   BspComplex& bsp = *complex;

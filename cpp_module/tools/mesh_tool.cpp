@@ -111,8 +111,9 @@ int main(int argc, char** argv) {
                 st.retried_along_lines ? " (retried along lines)" : "",
                 st.bsp_candidate_shift ? (" (retried with BSP candidate shift " + std::to_string(st.bsp_candidate_shift) + ")").c_str() : "");
     if (st.seed_tets > 0 || st.seed_fell_back)
-      std::printf("  seed: tets %lld missing edges %lld recovered %lld missing faces %lld recovered %lld flips %lld conflicts %lld relabelled faces %lld used %lld fell_back %lld\n",
-                  static_cast<long long>(st.seed_tets), static_cast<long long>(st.seed_missing_edges),
+      std::printf("  seed: tets %lld (untouched %lld) missing edges %lld recovered %lld missing faces %lld recovered %lld flips %lld conflicts %lld relabelled faces %lld used %lld fell_back %lld\n",
+                  static_cast<long long>(st.seed_tets), static_cast<long long>(st.seed_untouched_tets),
+                  static_cast<long long>(st.seed_missing_edges),
                   static_cast<long long>(st.seed_recovered_edges), static_cast<long long>(st.seed_missing_faces),
                   static_cast<long long>(st.seed_recovered_faces), static_cast<long long>(st.seed_flips),
                   static_cast<long long>(st.seed_conflicts),

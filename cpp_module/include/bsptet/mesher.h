@@ -63,6 +63,7 @@ struct MeshStats {
   std::int64_t bsp_nodes = 0, convex_cells = 0, inside_cells = 0, bsp_points = 0;
   std::int64_t delaunay_seeded = 0;  ///< 1 when the mesh was made from the Delaunay seed
   std::int64_t seed_tets = 0;  ///< cells of the Delaunay seed (also when kAuto then took the box)
+  std::int64_t seed_untouched_tets = 0;  ///< of those, kept out of the cell complex (bsp_complex.h UntouchedSeedTets)
   std::int64_t seed_conflicts = 0;  ///< (seed tet, input triangle crossing it) pairs (BspStats; kAuto stops counting past its bound)
   std::int64_t seed_faces_relabelled = 0;  ///< seed faces given their input plane by the walk (BspStats)
   std::int64_t seed_missing_edges = 0, seed_recovered_edges = 0, seed_flips = 0;  ///< BspStats
