@@ -735,13 +735,28 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // A seed face: verts CCW around its normal, tet[0] on the positive side (the normal points into
   // it), tet[1] on the negative side (-1: none). plane: the input plane it lies on, or -1 (not on
   // one: the complex gives it a plane of its own through its corners, in this vertex order).
+  // coplanar: the input triangles of its plane that may overlap it, as an index into
+  // `coplanar_lists` (-1: none; most faces have none).
   struct SeedFace {
     std::array<Index, 3> verts;
     Index plane;
     Index tet[2];
-    std::vector<Index> coplanar;
+    Index coplanar = -1;
   };
   std::vector<SeedFace> sfaces;
+  std::vector<std::vector<Index>> coplanar_lists;
+  const std::vector<Index> no_triangles;
+  auto coplanar_of = [&](const SeedFace& f) -> const std::vector<Index>& {
+    return f.coplanar < 0 ? no_triangles : coplanar_lists[f.coplanar];
+  };
+  auto add_coplanar = [&](SeedFace& f, Index tr) {
+    if (f.coplanar < 0) {
+      f.coplanar = static_cast<Index>(coplanar_lists.size());
+      coplanar_lists.emplace_back();
+    }
+    auto& list = coplanar_lists[f.coplanar];
+    if (list.empty() || list.back() != tr) list.push_back(tr);
+  };
   sfaces.reserve(2 * static_cast<std::size_t>(nt) + 8);
   std::vector<std::array<Index, 4>> tet_face(nt, {-1, -1, -1, -1});
   // The input plane a face lies on by its corners' triangles: every corner an input point known
@@ -763,7 +778,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       if (t1 >= 0 && t1 < t0) continue;  // made from the neighbour
       const Index x = tets[t0][kFace[i0][0]], y = tets[t0][kFace[i0][1]], z = tets[t0][kFace[i0][2]];
       const Index apex = tets[t0][i0];  // on the positive side of (x, y, z)
-      SeedFace f{{x, y, z}, -1, {t0, t1}, {}};
+      SeedFace f{{x, y, z}, -1, {t0, t1}, -1};
       const Index q = input_plane_of(x, y, z);
       const Index id = static_cast<Index>(sfaces.size());
       if (q >= 0) {
@@ -815,7 +830,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       const auto it = std::lower_bound(face_of_corners.begin(), face_of_corners.end(),
                                        std::pair<std::array<Index, 3>, Index>{key, -1});
       if (it != face_of_corners.end() && it->first == key && sfaces[it->second].plane == plane) {
-        sfaces[it->second].coplanar.push_back(tr);
+        add_coplanar(sfaces[it->second], tr);
         ++stats_.seed_face_triangles;
         continue;
       }
@@ -857,7 +872,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
           f.plane = plane;
           ++stats_.seed_faces_relabelled;
         }
-        if (f.plane == plane && (f.coplanar.empty() || f.coplanar.back() != tr)) f.coplanar.push_back(tr);
+        if (f.plane == plane) add_coplanar(f, tr);
         const Index n = nb[t][i];
         if (n >= 0 && seen[n] != stamp) {
           seen[n] = stamp;
@@ -881,7 +896,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     return a == b;
   };
   auto needs_refinement = [&](const SeedFace& f) {
-    return f.plane >= 0 && !f.coplanar.empty() && !is_input_triangle(f.verts, f.coplanar);
+    return f.plane >= 0 && !coplanar_of(f).empty() && !is_input_triangle(f.verts, coplanar_of(f));
   };
   std::vector<std::uint64_t> hot;
   for (Index t = 0; t < nt; ++t)
@@ -955,7 +970,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     bf.verts.assign(f.verts.begin(), f.verts.end());
     bf.cell[0] = c0;
     bf.cell[1] = c1;
-    bf.coplanar = std::move(f.coplanar);
+    if (f.coplanar >= 0) bf.coplanar = std::move(coplanar_lists[f.coplanar]);
     const Index id = new_face(std::move(bf));
     complex_face[i] = id;
     const Index other = c0 < 0 ? f.tet[0] : (c1 < 0 ? f.tet[1] : -1);
@@ -990,7 +1005,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       adj[i] = n < 0 ? -1 : (cell_of[n] >= 0 ? -2 - complex_face[tet_face[t][i]] : untouched_of[n]);
       const Index fi = tet_face[t][i];
       // (A face shared with a cell handed its coplanar list to the complex.)
-      const std::vector<Index>& cop = complex_face[fi] >= 0 ? faces_[complex_face[fi]].coplanar : sfaces[fi].coplanar;
+      const std::vector<Index>& cop =
+          complex_face[fi] >= 0 ? faces_[complex_face[fi]].coplanar : coplanar_of(sfaces[fi]);
       if (sfaces[fi].plane < 0 || cop.empty()) continue;
       const Index tr = cop[0];
       if (!is_input_triangle(sfaces[fi].verts, cop))
