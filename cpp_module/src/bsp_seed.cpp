@@ -95,10 +95,17 @@ class EdgePairDirection {
       if (c.sign() != 0) return false;
     return true;
   }
-  /// sign of n . (x - y), exactly.
+  /// sign of n . (x - y) = det[e1 - e0, f1 - f0, x - y], exactly: intervals, then expansions
+  /// when the three differences are exact in doubles (nearby points), else ExactFloat.
   int sign(const Vec3& x, const Vec3& y) {
     const int s = dot(approx_, difference<Interval>(x, y)).certain_sign();
-    return s != 0 ? s : dot(exact(), difference<ExactFloat>(x, y)).sign();
+    if (s != 0) return s;
+    Vec3 u, v, w;
+    Sign d;
+    if (exact_difference(e1_, e0_, u) && exact_difference(f1_, f0_, v) && exact_difference(x, y, w) &&
+        det3_expansion(u, v, w, d))
+      return to_int(d);
+    return dot(exact(), difference<ExactFloat>(x, y)).sign();
   }
 
  private:
@@ -257,10 +264,11 @@ class SeedFlips {
   void protect_triangle(Index a, Index b, Index c) {
     std::array<Index, 3> k{{a, b, c}};
     std::sort(k.begin(), k.end());
-    protected_faces_.insert(key3(k));
-    protected_edges_.insert(key2(a, b));
-    protected_edges_.insert(key2(b, c));
-    protected_edges_.insert(key2(a, c));
+    protected_faces_.push_back(key3(k));
+    protected_edges_.push_back(key2(a, b));
+    protected_edges_.push_back(key2(b, c));
+    protected_edges_.push_back(key2(a, c));
+    protection_sorted_ = false;
   }
 
   bool has_edge(Index a, Index b) const {
@@ -381,15 +389,22 @@ class SeedFlips {
     std::sort(k.begin(), k.end());
     return k;
   }
-  struct Key3Hash {
-    std::size_t operator()(const std::array<Index, 3>& k) const {
-      return std::hash<std::uint64_t>()((static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[0])) << 42) ^
-                                        (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[1])) << 21) ^
-                                        static_cast<std::uint64_t>(static_cast<std::uint32_t>(k[2])));
-    }
-  };
-  bool face_protected(Index x, Index y, Index z) const {
-    return protected_faces_.count(key3({x, y, z})) > 0;
+  // Sorted vectors, not hash sets: a tenth of the memory (the seed's peak), sorted once.
+  void sort_protection() {
+    if (protection_sorted_) return;
+    std::sort(protected_faces_.begin(), protected_faces_.end());
+    protected_faces_.erase(std::unique(protected_faces_.begin(), protected_faces_.end()), protected_faces_.end());
+    std::sort(protected_edges_.begin(), protected_edges_.end());
+    protected_edges_.erase(std::unique(protected_edges_.begin(), protected_edges_.end()), protected_edges_.end());
+    protection_sorted_ = true;
+  }
+  bool edge_protected(Index x, Index y) {
+    sort_protection();
+    return std::binary_search(protected_edges_.begin(), protected_edges_.end(), key2(x, y));
+  }
+  bool face_protected(Index x, Index y, Index z) {
+    sort_protection();
+    return std::binary_search(protected_faces_.begin(), protected_faces_.end(), key3({x, y, z}));
   }
   /// The alive tet other than `not_t` with the three vertices, or -1.
   Index tet_with(Index x, Index y, Index z, Index not_t) const {
@@ -458,7 +473,7 @@ class SeedFlips {
   // Edge (d, e) with exactly three tets around it, whose other vertices are a, b, c: replaced by
   // the two tets over face (a, b, c).
   bool flip32(Index d, Index e, Index a, Index b, Index c) {
-    if (protected_edges_.count(key2(d, e))) return false;
+    if (edge_protected(d, e)) return false;
     const std::vector<Index> ring = ring_around(d, e);
     if (ring.size() != 3) return false;
     for (Index t : ring) {
@@ -549,7 +564,7 @@ class SeedFlips {
   // outer faces (c, p_i, p_i+1) and (d, p_i, p_i+1) are kept, and positive cones over the two sides
   // of the polygon tile the edge's star (the 2-3, 3-2 and 4-4 flips are its cases n = 3, 4).
   bool remove_edge(Index c, Index d, Index a, Index e) {
-    if (protected_edges_.count(key2(c, d))) return false;
+    if (edge_protected(c, d)) return false;
     const std::vector<Index> ring = ring_around(c, d);
     const int n = static_cast<int>(ring.size());
     if (n < 3 || n > kMaxRing) return false;
@@ -624,8 +639,9 @@ class SeedFlips {
   std::vector<std::vector<Index>> inc_;
   std::vector<Vec3> pts_;
   std::vector<char> alive_;
-  std::unordered_set<std::array<Index, 3>, Key3Hash> protected_faces_;
-  std::unordered_set<std::uint64_t> protected_edges_;
+  std::vector<std::array<Index, 3>> protected_faces_;
+  std::vector<std::uint64_t> protected_edges_;
+  bool protection_sorted_ = true;
   std::int64_t flips_ = 0;
 };
 
@@ -898,10 +914,36 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   auto needs_refinement = [&](const SeedFace& f) {
     return f.plane >= 0 && !coplanar_of(f).empty() && !is_input_triangle(f.verts, coplanar_of(f));
   };
+  // A crossed tet T is split only by the planes of its conflict triangles (choose_plane), and
+  // its pieces' faces are refined only along lines inside them: a seed edge of T is cut only
+  // when one of those planes crosses it or contains it (then refinement lines in the plane may
+  // cross it). Such edges are hot, with the edges of the faces needing refinement; a seed tet
+  // goes into the complex when it is crossed, shares a face with a crossed tet (T's faces are
+  // split), or has a hot edge. (A split that reaches a tet left out throws, and the mesher
+  // retries from the box: bsp_complex.cpp.)
   std::vector<std::uint64_t> hot;
-  for (Index t = 0; t < nt; ++t)
-    if (!conflict[t].empty())
-      for (const auto& ed : kEdge) hot.push_back(edge_key(tets[t][ed[0]], tets[t][ed[1]]));
+  std::vector<char> near_crossed(static_cast<std::size_t>(nt), 0);
+  std::vector<Index> planes_of;
+  for (Index t = 0; t < nt; ++t) {
+    if (conflict[t].empty()) continue;
+    near_crossed[t] = 1;
+    for (int i = 0; i < 4; ++i)
+      if (nb[t][i] >= 0) near_crossed[nb[t][i]] = 1;
+    planes_of.clear();
+    for (Index tr : conflict[t]) planes_of.push_back(tri_plane_[tr]);
+    std::sort(planes_of.begin(), planes_of.end());
+    planes_of.erase(std::unique(planes_of.begin(), planes_of.end()), planes_of.end());
+    for (const auto& ed : kEdge) {
+      const Index a = tets[t][ed[0]], b = tets[t][ed[1]];
+      for (Index p : planes_of) {
+        const int sa = to_int(geo_.side(p, a)), sb = to_int(geo_.side(p, b));
+        if (sa * sb < 0 || (sa == 0 && sb == 0)) {
+          hot.push_back(edge_key(a, b));
+          break;
+        }
+      }
+    }
+  }
   for (const SeedFace& f : sfaces)
     if (needs_refinement(f))
       for (int k = 0; k < 3; ++k) hot.push_back(edge_key(f.verts[k], f.verts[(k + 1) % 3]));
@@ -915,13 +957,10 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   std::vector<Index> cell_of(static_cast<std::size_t>(nt), -1), untouched_of(static_cast<std::size_t>(nt), -1);
   Index num_cells = 0, num_untouched = 0;
   for (Index t = 0; t < nt; ++t) {
-    bool in = false;
-    for (const auto& ed : kEdge) {
-      const Index a = tets[t][ed[0]], b = tets[t][ed[1]];
-      if (hot_vertex[a] && hot_vertex[b] && std::binary_search(hot.begin(), hot.end(), edge_key(a, b))) {
-        in = true;
-        break;
-      }
+    bool in = near_crossed[t] != 0;
+    for (int k = 0; k < 6 && !in; ++k) {
+      const Index a = tets[t][kEdge[k][0]], b = tets[t][kEdge[k][1]];
+      in = hot_vertex[a] && hot_vertex[b] && std::binary_search(hot.begin(), hot.end(), edge_key(a, b));
     }
     (in ? cell_of[t] = num_cells++ : untouched_of[t] = num_untouched++);
   }

@@ -209,10 +209,8 @@ bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 // nearby points (differences exact by Sterbenz's lemma) on one plane or sphere. det[B, C, D] with
 // B = b - a, ...: each 2x2 minor of C, D an expansion of 4 (TwoProduct), scaled by B's entry (8),
 // summed (24); far cheaper than the 4x4 form of orient3d_expansion.
-bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
-  double B[3], C[3], D[3];
-  for (int k = 0; k < 3; ++k)
-    if (!exact_diff(b[k], a[k], B[k]) || !exact_diff(c[k], a[k], C[k]) || !exact_diff(d[k], a[k], D[k])) return false;
+bool det3_expansion(const Vec3& u, const Vec3& v, const Vec3& w, Sign& out) {
+  const double B[3] = {u.x, u.y, u.z}, C[3] = {v.x, v.y, v.z}, D[3] = {w.x, w.y, w.z};
   for (const double* p : {B, C, D})
     for (int k = 0; k < 3; ++k) {
       const double m = std::fabs(p[k]);
@@ -234,6 +232,16 @@ bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c,
   const int lt = expansion_sum(s12, l12, s3, l3, total, tmp);
   out = sign_of(total[lt - 1]);
   return true;
+}
+
+bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
+  Vec3 B, C, D;
+  if (!exact_difference(b, a, B) || !exact_difference(c, a, C) || !exact_difference(d, a, D)) return false;
+  return det3_expansion(B, C, D, out);
+}
+
+bool exact_difference(const Vec3& p, const Vec3& q, Vec3& out) {
+  return exact_diff(p.x, q.x, out.x) && exact_diff(p.y, q.y, out.y) && exact_diff(p.z, q.z, out.z);
 }
 
 Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {

@@ -37,6 +37,11 @@ bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
 /// orient3d_expansion: far cheaper); false, and `out` unset, when a difference is not exact in
 /// doubles or a nonzero one's magnitude is outside [2^-200, 2^200].
 bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out);
+/// The exact sign of det[u, v, w] (rows) of double vectors by expansions; false, and `out` unset,
+/// when a nonzero component's magnitude is outside [2^-200, 2^200].
+bool det3_expansion(const Vec3& u, const Vec3& v, const Vec3& w, Sign& out);
+/// out = p - q when every component's difference is exact in doubles (then true).
+bool exact_difference(const Vec3& p, const Vec3& q, Vec3& out);
 
 /// Filters for points known only approximately: each exact point lies within r (per coordinate)
 /// of the given double point (a TPI vertex's rounded coordinates and its enclosing box). True,
