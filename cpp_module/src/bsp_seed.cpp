@@ -684,7 +684,28 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
     keyed.push_back({code, v});
   }
-  std::sort(keyed.begin(), keyed.end());
+  // Biased randomized insertion order (Amenta, Choi and Rote): the points shuffled by a fixed
+  // generator, then split in rounds of doubling size (the last holds half of them), each round in
+  // Morton order. Morton order alone inserts a surface's points one sheet after the other, and
+  // each new point then conflicts with the long tets spanning the empty inside: cavities grew
+  // with the input (the Delaunay of a 10^6-triangle CAD part took 17 times that of 10^5). The
+  // triangulation itself does not depend on the order.
+  {
+    std::uint64_t rng = 0xB210ULL;
+    auto next = [&rng]() {
+      std::uint64_t z = (rng += 0x9E3779B97F4A7C15ULL);
+      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+      z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+      return z ^ (z >> 31);
+    };
+    for (std::size_t i = keyed.size(); i > 1; --i) std::swap(keyed[i - 1], keyed[next() % i]);
+    std::size_t end = keyed.size();
+    while (end > 0) {
+      const std::size_t begin = end > 2048 ? end / 2 : 0;
+      std::sort(keyed.begin() + static_cast<std::ptrdiff_t>(begin), keyed.begin() + static_cast<std::ptrdiff_t>(end));
+      end = begin;
+    }
+  }
   std::vector<Index> order;
   order.reserve(keyed.size() + 8);
   for (Index c = corner0_; c < corner0_ + 8; ++c) order.push_back(c);
