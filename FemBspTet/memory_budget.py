@@ -4,11 +4,14 @@
     budget = parse_size("4G")                         # 4 * 2**30 bytes
     require_within_budget(surfaces, budget)           # MemoryBudgetError if the estimate exceeds it
 
-The estimate is an upper envelope measured on the corpus and the paper models (peak resident
-memory of ``bsptet_mesh`` against the triangle count, ``docs/bad-input.md``), times a safety
-factor. The BSP's size depends on the geometry, not only on the counts, so it is an estimate: the
-supervised CLI also watches the run's real resident memory against the same budget
-(:mod:`FemBspTet.supervisor`) and stops it if it goes over.
+The estimate is the typical peak with margin: about 1 to 3 KiB per input triangle measured from
+10^3 to 10^6 triangles (session 20, ``docs/bad-input.md``), taken as 4 KiB, plus the
+interpreter's share. The BSP's size depends on the geometry, not only on the counts (inputs
+whose triangles cross many seed tets reach tens of KiB per triangle), so it is only a first
+filter: the supervised CLI also watches the run's real resident memory against the same budget
+(:mod:`FemBspTet.supervisor`) and stops it if it goes over. An envelope over those worst cases
+(session 2's 80 KiB per triangle) refused every input above a few 10^5 triangles on a 24 GiB
+machine, although 10^6 triangles take about 1 GiB.
 """
 
 import math
@@ -21,10 +24,9 @@ __all__ = ["estimate_peak_bytes", "parse_size", "default_budget", "require_withi
 
 #: Fixed cost of a run: the Python interpreter, numpy, the core's tables (bytes).
 BASE_BYTES = 96 << 20
-#: Measured peak per input triangle, upper envelope (bytes); see docs/bad-input.md.
-BYTES_PER_TRIANGLE = 80 << 10
-#: The envelope grows like n log n on the corpus; normalised at 1000 triangles.
-_LOG_REFERENCE = math.log2(1000)
+#: Typical peak per input triangle with margin (bytes); see docs/bad-input.md. The measured
+#: peak grows no faster than the triangle count (memory exponents 0.85 to 0.97, 10^4 to 10^6).
+BYTES_PER_TRIANGLE = 4 << 10
 
 _UNITS = {"": 1, "b": 1, "k": 1 << 10, "kb": 1 << 10, "kib": 1 << 10, "m": 1 << 20, "mb": 1 << 20,
           "mib": 1 << 20, "g": 1 << 30, "gb": 1 << 30, "gib": 1 << 30, "t": 1 << 40, "tb": 1 << 40,
@@ -34,8 +36,7 @@ _UNITS = {"": 1, "b": 1, "k": 1 << 10, "kb": 1 << 10, "kib": 1 << 10, "m": 1 << 
 def estimate_peak_bytes(n_points, n_triangles):
     """Estimated peak memory (bytes) of meshing a surface of ``n_triangles`` triangles."""
     n = max(int(n_triangles), 1)
-    growth = max(1.0, math.log2(max(n, 2)) / _LOG_REFERENCE)
-    return int(BASE_BYTES + BYTES_PER_TRIANGLE * n * growth + 64 * max(int(n_points), 0))
+    return int(BASE_BYTES + BYTES_PER_TRIANGLE * n + 64 * max(int(n_points), 0))
 
 
 def format_bytes(n):
