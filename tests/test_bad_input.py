@@ -197,7 +197,7 @@ TABLE = [
      ["inconsistent"], ["td_spike-1-10.off", "triangles 0 and 8"]),
     ("corpus: inward-facing", existing(corpus_path("engine_bracket")), [], 2,
      ["faces inward"], ["engine_bracket.off", "triangle 0"]),
-    ("memory budget (estimate)", big_surface, ["--max-memory", "300M"], 2,
+    ("memory budget (estimate)", big_surface, ["--max-memory", "150M"], 2,
      ["estimated", "memory budget", "--max-memory"], ["big.off", "20000 triangles"]),
     ("bad --max-memory", existing(paper_path("schoenhardt")), ["--max-memory", "lots"], 2,
      ["cannot read 'lots' as a size"], ["--max-memory"]),
