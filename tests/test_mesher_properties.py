@@ -281,3 +281,22 @@ def test_seed_planar_flips_on_fanned_caps(n, h):
     assert report["boundary_steiner_points"] == 0
     vol = core.signed_volume(s)
     assert abs(mesh_volume(mesh) - vol) <= 1e-12 * vol
+
+
+def test_seed_tets_no_triangle_crosses_stay_out_of_the_complex():
+    """knot2: every input triangle is a face of the Delaunay seed, so no split or refinement can
+    reach any seed tet: all of them stay out of the cell complex (classified and output as they
+    are), and the mesh is the seed's inside tets, valid, without a Steiner point."""
+    s = read_surface(corpus_path("knot2"))
+    mesh, stats = core.tetrahedralize(s)
+    assert stats["bsp_seed"] == "delaunay" and stats["seed_conflicts"] == 0
+    assert stats["seed_untouched_tets"] == stats["seed_tets"] > 0
+    report = core.check_mesh(s, mesh)
+    assert report["valid"], "; ".join(report["messages"])
+    assert len(mesh.points) == len(s.points)
+    # pinion: triangles cross some seed tets; those and their neighbours go into the complex.
+    p = read_surface(corpus_path("pinion"))
+    pmesh, pst = core.tetrahedralize(p)
+    assert pst["seed_conflicts"] > 0
+    assert 0 < pst["seed_untouched_tets"] < pst["seed_tets"]
+    assert core.check_mesh(p, pmesh)["valid"]
