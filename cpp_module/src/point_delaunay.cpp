@@ -177,13 +177,12 @@ class Builder {
   }
 
   bool insert(int e) {
-    ++stamp_;
-    if (stamp_ == 0) {
+    // Two fresh stamps per insertion (never 0, the value of a new tet's mark).
+    if (stamp_ >= 0xFFFFFFF0u) {
       std::fill(mark_.begin(), mark_.end(), 0u);
-      stamp_ = 2;
+      stamp_ = 0;
     }
-    const std::uint32_t in = stamp_, out_mark = stamp_ + 1;  // in the cavity / tested, not in it
-    ++stamp_;
+    const std::uint32_t in = ++stamp_, out_mark = ++stamp_;  // in the cavity / tested, not in it
     int t0 = locate(e);
     if (t0 < 0 || !conflict(t0, e)) {
       t0 = -1;
