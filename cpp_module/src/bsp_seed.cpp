@@ -36,6 +36,7 @@
 #include "bsptet/exact_float.h"
 #include "bsptet/interval.h"
 #include "bsptet/point_delaunay.h"
+#include "bsptet/splitmix.h"
 #include "bsptet/predicates.h"
 
 namespace bsptet {
@@ -659,7 +660,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // Vertex ids of explicit points are their point ids here (mesher.cpp adds them in order).
   auto point_of = [&](Index v) -> const Vec3& { return geo_.explicit_point(geo_.explicit_id(v)); };
   // 1. The points: the box corners first (their hull is the box, so every walk stays inside),
-  // then the input points that triangles use, in Morton order of their coordinates (short walks).
+  // then the input points that triangles use, in the order below (short walks, small cavities).
   std::vector<char> used(static_cast<std::size_t>(corner0_), 0);
   for (Index v : surface_.tri) used[v] = 1;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -692,13 +693,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // triangulation itself does not depend on the order.
   {
     std::uint64_t rng = 0xB210ULL;
-    auto next = [&rng]() {
-      std::uint64_t z = (rng += 0x9E3779B97F4A7C15ULL);
-      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-      z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-      return z ^ (z >> 31);
-    };
-    for (std::size_t i = keyed.size(); i > 1; --i) std::swap(keyed[i - 1], keyed[next() % i]);
+    for (std::size_t i = keyed.size(); i > 1; --i) std::swap(keyed[i - 1], keyed[splitmix64(rng) % i]);
     std::size_t end = keyed.size();
     while (end > 0) {
       const std::size_t begin = end > 2048 ? end / 2 : 0;
@@ -991,10 +986,21 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
 
   // 5. The complex: the cells of those tets and their faces. A face between a cell and an
   // untouched tet keeps cell -1 on that side and remembers the tet (face_untouched).
+  auto in_complex = [&](const SeedFace& f) {
+    return (f.tet[0] >= 0 && cell_of[f.tet[0]] >= 0) || (f.tet[1] >= 0 && cell_of[f.tet[1]] >= 0);
+  };
+  // The faces of the cells, in the order of their sorted corners (the refinements visit faces by
+  // id: a fixed order that does not depend on how the seed's tets were numbered).
+  std::vector<std::pair<std::array<Index, 3>, Index>> made;
+  for (std::size_t i = 0; i < sfaces.size(); ++i)
+    if (in_complex(sfaces[i])) {
+      std::array<Index, 3> key = sfaces[i].verts;
+      std::sort(key.begin(), key.end());
+      made.push_back({key, static_cast<Index>(i)});
+    }
+  std::sort(made.begin(), made.end());
   {
-    std::size_t num_faces = 0;
-    for (const SeedFace& f : sfaces)
-      num_faces += (f.tet[0] >= 0 && cell_of[f.tet[0]] >= 0) || (f.tet[1] >= 0 && cell_of[f.tet[1]] >= 0);
+    const std::size_t num_faces = made.size();
     // Capacity for the seed and an eighth more for the splits: growing a vector doubles it (and
     // holds old and new at once), which made these two vectors the peak of the BSP's memory.
     faces_.reserve(faces_.size() + num_faces + num_faces / 8);
@@ -1008,18 +1014,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   }
   cells_.assign(static_cast<std::size_t>(num_cells), BspCell{});
   std::vector<Index> complex_face(sfaces.size(), -1);
-  // In the order of their sorted corners (the refinements visit faces by id: a fixed order that
-  // does not depend on how the seed's tets were numbered).
-  std::vector<std::pair<std::array<Index, 3>, Index>> made;
-  for (std::size_t i = 0; i < sfaces.size(); ++i) {
-    const SeedFace& f = sfaces[i];
-    if ((f.tet[0] >= 0 && cell_of[f.tet[0]] >= 0) || (f.tet[1] >= 0 && cell_of[f.tet[1]] >= 0)) {
-      std::array<Index, 3> key = f.verts;
-      std::sort(key.begin(), key.end());
-      made.push_back({key, static_cast<Index>(i)});
-    }
-  }
-  std::sort(made.begin(), made.end());
+  face_untouched_.assign(faces_.size() + made.size(), -1);
   for (const auto& [key, i] : made) {
     SeedFace& f = sfaces[i];
     const Index c0 = f.tet[0] >= 0 ? cell_of[f.tet[0]] : -1, c1 = f.tet[1] >= 0 ? cell_of[f.tet[1]] : -1;
@@ -1034,10 +1029,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     const Index id = new_face(std::move(bf));
     complex_face[i] = id;
     const Index other = c0 < 0 ? f.tet[0] : (c1 < 0 ? f.tet[1] : -1);
-    if (other >= 0) {
-      if (face_untouched_.size() <= static_cast<std::size_t>(id)) face_untouched_.resize(id + 1, -1);
-      face_untouched_[id] = untouched_of[other];
-    }
+    if (other >= 0) face_untouched_[id] = untouched_of[other];
   }
   // A cell's face boxes are left to split_cell, which builds them when they are out of step:
   // most seed tets are never split, and four boxes per tet were a fifth of the seed's memory.

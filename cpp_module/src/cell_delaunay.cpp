@@ -9,19 +9,9 @@
 
 #include "bsptet/cell_tetrahedralize.h"
 #include "bsptet/errors.h"
+#include "bsptet/splitmix.h"
 
 namespace bsptet {
-
-namespace {
-
-std::uint64_t splitmix(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
-
-}  // namespace
 
 std::vector<std::array<Index, 3>> delaunay_face(ImplicitGeometry& geo, const BspFace& face) {
   std::vector<std::array<Index, 3>> tris = triangulate_face(geo, face);
@@ -121,17 +111,15 @@ class BowyerWatson {
         if (geo_.known_on_plane(p_[i], planes_[k])) mask_[i] |= std::uint64_t(1) << k;
   }
 
-  /// `shuffle`: insert in an order drawn from `seed`; otherwise in the order of the points (a
-  /// spatially sorted order keeps the walks short; the result is the same either way).
-  bool run(std::uint64_t seed, bool shuffle = true) {
+  /// Inserts the points in an order drawn from `seed` (the result does not depend on it).
+  bool run(std::uint64_t seed) {
     const int n = static_cast<int>(p_.size());
     if (n < 4) return false;
     std::vector<int> order(n);
     for (int i = 0; i < n; ++i) order[i] = i;
     std::uint64_t s = seed;
-    if (shuffle)
-      for (int i = n - 1; i > 0; --i) std::swap(order[i], order[static_cast<int>(splitmix(s) % (i + 1))]);
-    rng_ = splitmix(s);
+    for (int i = n - 1; i > 0; --i) std::swap(order[i], order[static_cast<int>(splitmix64(s) % (i + 1))]);
+    rng_ = splitmix64(s);
     // First tet: the first point, the next, the first not collinear, the first not coplanar.
     const int a = order[0], b = order[1];
     int c = -1, d = -1;
@@ -318,7 +306,7 @@ class BowyerWatson {
     for (std::size_t step = 0; step < cap; ++step) {
       if (tets_[t].v[3] == kInf) return t;  // crossed a hull face strictly: e is beyond it
       const auto& v = tets_[t].v;
-      const int r = static_cast<int>(splitmix(rng_) & 3);
+      const int r = static_cast<int>(splitmix64(rng_) & 3);
       int next = -1;
       for (int k = 0; k < 4 && next < 0; ++k) {
         const int i = (r + k) & 3;
@@ -403,12 +391,6 @@ bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::
                    std::uint64_t seed, CellDelaunay& out) {
   BowyerWatson bw(geo, std::move(points), planes);
   if (!bw.run(seed)) return false;
-  return bw.collect(out);
-}
-
-bool delaunay_points(ImplicitGeometry& geo, std::vector<Index> points, CellDelaunay& out) {
-  BowyerWatson bw(geo, std::move(points), {});
-  if (!bw.run(0x5eedULL, false)) return false;
   return bw.collect(out);
 }
 

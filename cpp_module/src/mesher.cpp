@@ -122,7 +122,7 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     std::array<double, 4> key;
     for (int i = 0; i < 3; ++i) key[i] = n[i].truncated_quotient(n[k]);
     key[3] = d.truncated_quotient(n[k]);
-    const auto [slot, fresh] = buckets.try_emplace(key, -1);
+    const auto slot = buckets.try_emplace(key, -1).first;
     Index plane = -1;
     for (Index r = slot->second; r >= 0 && plane < 0; r = reps[r].next) {
       const Index rep = reps[r].tri;
@@ -133,16 +133,9 @@ std::vector<Index> group_planes(ImplicitGeometry& geo, const SurfaceMesh& s) {
     }
     if (plane < 0) {
       plane = geo.add_plane(a, b, c);
-      // Appended at the chain's end (the order the old per-key lists kept).
-      const Index id = static_cast<Index>(reps.size());
-      reps.push_back({plane, t0, -1});
-      if (slot->second < 0) {
-        slot->second = id;
-      } else {
-        Index r = slot->second;
-        while (reps[r].next >= 0) r = reps[r].next;
-        reps[r].next = id;
-      }
+      // At the chain's head (distinct planes are not coplanar: at most one entry can match).
+      reps.push_back({plane, t0, slot->second});
+      slot->second = static_cast<Index>(reps.size() - 1);
     }
     // The edge-connected triangles exactly on t0's plane.
     tri_plane[t0] = plane;

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "bsptet/predicates.h"
+#include "bsptet/splitmix.h"
 
 namespace bsptet {
 
@@ -13,20 +14,13 @@ namespace {
 constexpr int kInf = -1;  // the ghost vertex (a ghost tet has it at corner 3, and only there)
 constexpr auto& kFace = kTetOppositeFace;
 
-std::uint64_t splitmix(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
-
 // Bowyer-Watson with ghost tets: a ghost (a, b, c, INF) carries hull face (a, b, c), the outside
 // on its positive side. Local ids 0..n-1 index pts_ and ids_.
 class Builder {
  public:
   Builder(ImplicitGeometry& geo, const std::vector<Index>& order) : geo_(geo), ids_(order) {
-    std::uint64_t s = 0x5eedULL;  // the walk's face order: delaunay_points' generator
-    rng_ = splitmix(s);
+    std::uint64_t s = 0x5eedULL;  // the walk's face order (the seed's before session 20)
+    rng_ = splitmix64(s);
     pts_.reserve(order.size());
     for (Index v : order) pts_.push_back(geo.explicit_point(geo.explicit_id(v)));
     const std::size_t cap = 7 * order.size() + 64;
@@ -163,7 +157,7 @@ class Builder {
     for (std::size_t step = 0; step < cap; ++step) {
       if (v_[t][3] == kInf) return t;
       const auto& v = v_[t];
-      const int r = static_cast<int>(splitmix(rng_) & 3);
+      const int r = static_cast<int>(splitmix64(rng_) & 3);
       int next = -1;
       for (int k = 0; k < 4 && next < 0; ++k) {
         const int i = (r + k) & 3;

@@ -85,13 +85,10 @@ bool orient2d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, int 
   return true;
 }
 
-// sign(orient3d) when its double evaluation is exact; false otherwise.
-bool orient3d_exact_in_doubles(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
-  double bx, by, bz, cx, cy, cz, dx, dy, dz;
-  if (!exact_diff(b.x, a.x, bx) || !exact_diff(b.y, a.y, by) || !exact_diff(b.z, a.z, bz) ||
-      !exact_diff(c.x, a.x, cx) || !exact_diff(c.y, a.y, cy) || !exact_diff(c.z, a.z, cz) ||
-      !exact_diff(d.x, a.x, dx) || !exact_diff(d.y, a.y, dy) || !exact_diff(d.z, a.z, dz))
-    return false;
+// sign(det[B, C, D]) of exact differences B = b - a, ... when its double evaluation is exact;
+// false otherwise.
+bool det3_exact_in_doubles(const Vec3& B, const Vec3& C, const Vec3& D, Sign& out) {
+  const double bx = B.x, by = B.y, bz = B.z, cx = C.x, cy = C.y, cz = C.z, dx = D.x, dy = D.y, dz = D.z;
   double m1, m2, m3, m4, m5, m6, n1, n2, n3, t1, t2, t3, s12, det;
   if (!exact_prod(cy, dz, m1) || !exact_prod(cz, dy, m2) || !exact_prod(cx, dz, m3) || !exact_prod(cz, dx, m4) ||
       !exact_prod(cx, dy, m5) || !exact_prod(cy, dx, m6) || !exact_diff(m1, m2, n1) || !exact_diff(m3, m4, n2) ||
@@ -148,14 +145,16 @@ int scale_expansion(const double* e, int n, double b, double* h) {
   if (q != 0 || k == 0) h[k++] = q;
   return k;
 }
-// The 2x2 minor p.x * q.y - q.x * p.y as an expansion of at most 4 components.
-int minor_xy(const Vec3& p, const Vec3& q, double* h) {
-  double a[2], b[2], tmp[4];
-  two_product(p.x, q.y, a[1], a[0]);
-  two_product(q.x, p.y, b[1], b[0]);
-  b[0] = -b[0], b[1] = -b[1];
-  return expansion_sum(a, 2, b, 2, h, tmp);
+// a * b - c * d exactly, as an expansion of at most 4 components.
+int two_by_two(double a, double b, double c, double d, double* h) {
+  double p[2], q[2], tmp[4];
+  two_product(a, b, p[1], p[0]);
+  two_product(c, d, q[1], q[0]);
+  q[0] = -q[0], q[1] = -q[1];
+  return expansion_sum(p, 2, q, 2, h, tmp);
 }
+// The 2x2 minor p.x * q.y - q.x * p.y as an expansion of at most 4 components.
+int minor_xy(const Vec3& p, const Vec3& q, double* h) { return two_by_two(p.x, q.y, q.x, p.y, h); }
 
 }  // namespace
 
@@ -204,44 +203,36 @@ bool orient3d_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3&
   return true;
 }
 
-// sign(orient3d) by expansions of the exact differences, or false when a difference is not exact
-// in doubles or is outside [2^-200, 2^200] in magnitude. The common case of the exact stages:
-// nearby points (differences exact by Sterbenz's lemma) on one plane or sphere. det[B, C, D] with
-// B = b - a, ...: each 2x2 minor of C, D an expansion of 4 (TwoProduct), scaled by B's entry (8),
-// summed (24); far cheaper than the 4x4 form of orient3d_expansion.
+// sign(det[u, v, w]) (rows) by expansions, or false when a nonzero entry is outside
+// [2^-200, 2^200] in magnitude (a TwoProduct residual could underflow). Each 2x2 minor of v, w is
+// an expansion of 4 components, scaled by u's entry (8), summed (24): for exact differences of
+// nearby points (Sterbenz's lemma) on one plane or sphere, far cheaper than the 4x4 form of
+// orient3d_expansion.
 bool det3_expansion(const Vec3& u, const Vec3& v, const Vec3& w, Sign& out) {
-  const double B[3] = {u.x, u.y, u.z}, C[3] = {v.x, v.y, v.z}, D[3] = {w.x, w.y, w.z};
-  for (const double* p : {B, C, D})
+  for (const Vec3* p : {&u, &v, &w})
     for (int k = 0; k < 3; ++k) {
-      const double m = std::fabs(p[k]);
+      const double m = std::fabs((*p)[k]);
       if (m != 0 && !(m >= 0x1p-200 && m <= 0x1p200)) return false;
     }
-  // minor(i, j) = C_i D_j - C_j D_i
-  auto minor = [&](int i, int j, double* h) {
-    double p[2], q[2], tmp[4];
-    two_product(C[i], D[j], p[1], p[0]);
-    two_product(C[j], D[i], q[1], q[0]);
-    q[0] = -q[0], q[1] = -q[1];
-    return expansion_sum(p, 2, q, 2, h, tmp);
-  };
   double m1[4], m2[4], m3[4], s1[8], s2[8], s3[8], s12[16], tmp[24], total[24];
-  const int n1 = minor(1, 2, m1), n2 = minor(2, 0, m2), n3 = minor(0, 1, m3);
-  const int l1 = scale_expansion(m1, n1, B[0], s1), l2 = scale_expansion(m2, n2, B[1], s2),
-            l3 = scale_expansion(m3, n3, B[2], s3);
+  const int n1 = two_by_two(v.y, w.z, v.z, w.y, m1), n2 = two_by_two(v.z, w.x, v.x, w.z, m2),
+            n3 = two_by_two(v.x, w.y, v.y, w.x, m3);
+  const int l1 = scale_expansion(m1, n1, u.x, s1), l2 = scale_expansion(m2, n2, u.y, s2),
+            l3 = scale_expansion(m3, n3, u.z, s3);
   const int l12 = expansion_sum(s1, l1, s2, l2, s12, tmp);
   const int lt = expansion_sum(s12, l12, s3, l3, total, tmp);
   out = sign_of(total[lt - 1]);
   return true;
 }
 
-bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
-  Vec3 B, C, D;
-  if (!exact_difference(b, a, B) || !exact_difference(c, a, C) || !exact_difference(d, a, D)) return false;
-  return det3_expansion(B, C, D, out);
-}
-
 bool exact_difference(const Vec3& p, const Vec3& q, Vec3& out) {
   return exact_diff(p.x, q.x, out.x) && exact_diff(p.y, q.y, out.y) && exact_diff(p.z, q.z, out.z);
+}
+
+bool orient3d_differences_expansion(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, Sign& out) {
+  Vec3 B, C, D;
+  return exact_difference(b, a, B) && exact_difference(c, a, C) && exact_difference(d, a, D) &&
+         det3_expansion(B, C, D, out);
 }
 
 Sign orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
@@ -266,8 +257,12 @@ Sign orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const double bound = kOrient3dBound * perm;
   if (std::isfinite(perm) && perm > kUnderflowGuard && std::fabs(det) > bound) return sign_of(det);
   Sign certified;
-  if (orient3d_exact_in_doubles(a, b, c, d, certified)) return certified;
-  if (orient3d_differences_expansion(a, b, c, d, certified)) return certified;
+  // Differences exact in doubles (nearby points): the evaluation itself if exact, else their
+  // expansions; otherwise the 4x4 expansions of the coordinates.
+  Vec3 B, C, D;
+  if (exact_difference(b, a, B) && exact_difference(c, a, C) && exact_difference(d, a, D) &&
+      (det3_exact_in_doubles(B, C, D, certified) || det3_expansion(B, C, D, certified)))
+    return certified;
   if (orient3d_expansion(a, b, c, d, certified)) return certified;
   return orient3d_exact(a, b, c, d);
 }

@@ -67,11 +67,6 @@ struct CellDelaunay {
 bool delaunay_cell(ImplicitGeometry& geo, std::vector<Index> points, const std::vector<Index>& planes,
                    std::uint64_t seed, CellDelaunay& out);
 
-/// The same Delaunay tetrahedralization of `points` (distinct vertex ids, not all coplanar),
-/// inserted in the given order (no shuffle: give a spatially sorted order, the walks stay short;
-/// the result does not depend on the order). Used to seed the BSP (BspComplex::seed_delaunay).
-bool delaunay_points(ImplicitGeometry& geo, std::vector<Index> points, CellDelaunay& out);
-
 /// Boundary recovery for a cell whose Delaunay boundary differs from its faces' triangulations on
 /// some facet planes (a facet made of several BSP faces). `tets` (positive, tiling the cell) is
 /// modified in place; `want` holds the required boundary triangles, outward (counter-clockwise seen
