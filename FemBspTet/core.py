@@ -78,7 +78,7 @@ def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_
     )
 
 
-def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000):
+def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000, self_intersections=True):
     """Checks that ``surface`` bounds a solid the mesher can fill, exactly, before any meshing.
 
     The checks and their order are in ``cpp_module/include/bsptet/surface_check.h``: finite
@@ -95,12 +95,13 @@ def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000):
     native = _native()
     where = surface.source or None
     try:
-        tri, info = native.check_surface(surface.points, surface.triangles, reorient=bool(reorient),
-                                         max_reported_pairs=int(max_reported_pairs))
+        with _self_intersection_errors(surface):
+            tri, info = native.check_surface(surface.points, surface.triangles, reorient=bool(reorient),
+                                             self_intersections=bool(self_intersections),
+                                             max_reported_pairs=int(max_reported_pairs))
+    except SelfIntersectionError:
+        raise
     except native.InputError as exc:
-        if getattr(exc, "code", "") == "self_intersection":
-            raise SelfIntersectionError(str(exc), where=where, pairs=np.asarray(exc.pairs),
-                                        complete=bool(exc.complete), surface=surface) from None
         raise InputError(str(exc), where=where, code=getattr(exc, "code", None)) from None
     except ValueError as exc:  # array shapes or indices beyond 32 bits (the binding's checks)
         raise InputError(str(exc), where=where, code="bad_argument") from None
@@ -108,6 +109,19 @@ def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000):
     if info["flipped_triangles"]:
         surface = Surface(surface.points, tri, surface.face_tags, surface.source)
     return surface, info
+
+
+@contextlib.contextmanager
+def _self_intersection_errors(surface: Surface):
+    """The native self-intersection error (an InputError with ``pairs``) as SelfIntersectionError."""
+    native = _native()
+    try:
+        yield
+    except native.InputError as exc:
+        if getattr(exc, "code", "") != "self_intersection":
+            raise
+        raise SelfIntersectionError(str(exc), where=surface.source or None, pairs=np.asarray(exc.pairs),
+                                    complete=bool(exc.complete), surface=surface) from None
 
 
 def tet_quality(mesh: TetMesh):
@@ -211,12 +225,18 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
                    if k not in ("order", "projection", "separate_face_tags", "thickness_ratio"))
     separating = bool(options.get("separate_face_tags"))
     native = _native()
+    reorient = bool(options.get("reorient", False))
+    # Every surface is checked before any is meshed, all but the self-intersection search, which
+    # runs beside the core on a second thread (the native check_and_tetrahedralize) when its
+    # surface is meshed: the same errors as check_surface's, a crossing reported after the other
+    # surfaces' other problems.
     checked, flipped = [], 0
     for surface in surfaces:
-        surface, info = check_surface(surface, reorient=bool(options.get("reorient", False)))
-        checked.append(surface)
+        checked_surface, info = check_surface(surface, reorient=reorient, self_intersections=False)
+        checked.append((surface, checked_surface))
         flipped += info["flipped_triangles"]
-    surfaces = checked
+    originals = [original for original, _ in checked]
+    surfaces = [surface for _, surface in checked]
     if options.get("max_memory") is not None:
         from .memory_budget import require_within_budget
 
@@ -229,11 +249,12 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             if progress is not None:
                 progress(label + stage, fraction)
 
-        with _core_errors(surface, "mesher"):
+        with _core_errors(surface, "mesher"), _self_intersection_errors(originals[k]):
             points, tets, st = native.tetrahedralize(
-                surface.points, surface.triangles,
+                originals[k].points, originals[k].triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
-                progress=report, cancel=cancel, **_native_core_options(options))
+                progress=report, cancel=cancel, check={"reorient": reorient},
+                **_native_core_options(options))
         mesh = TetMesh(points, tets, surface.source)
         report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):

@@ -128,6 +128,23 @@ PYBIND11_MODULE(_bsptet, m) {
   // Core errors reach Python as these types; FemBspTet.core turns them into FemBspTet.errors.
   static py::exception<void> input_error(m, "InputError", PyExc_ValueError);
   static py::exception<void> meshing_error(m, "MeshingError", PyExc_RuntimeError);
+  // A self-intersection raises InputError with `pairs` (k, 2) and `complete` besides `code` and
+  // `index`.
+  static auto raise_self_intersection = [](const SelfIntersectionError& e) {
+    py::array_t<std::int64_t> pairs({static_cast<py::ssize_t>(e.pairs().size()), static_cast<py::ssize_t>(2)});
+    auto out = pairs.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < e.pairs().size(); ++i) {
+      out(static_cast<py::ssize_t>(i), 0) = e.pairs()[i][0];
+      out(static_cast<py::ssize_t>(i), 1) = e.pairs()[i][1];
+    }
+    py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
+    exc.attr("code") = error_code_name(e.code());
+    exc.attr("index") = e.index();
+    exc.attr("pairs") = pairs;
+    exc.attr("complete") = e.complete();
+    PyErr_SetObject(input_error.ptr(), exc.ptr());
+    throw py::error_already_set();
+  };
   py::register_exception_translator([](std::exception_ptr p) {
     // The Python exception carries the core's error code name and element index.
     auto raise = [](const py::exception<void>& type, const Error& e) {
@@ -138,6 +155,12 @@ PYBIND11_MODULE(_bsptet, m) {
     };
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const SelfIntersectionError& e) {
+      try {
+        raise_self_intersection(e);
+      } catch (py::error_already_set& set) {
+        set.restore();
+      }
     } catch (const InputError& e) {
       raise(input_error, e);
     } catch (const MeshingError& e) {
@@ -148,7 +171,8 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "tetrahedralize",
       [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
-         py::object cancel, bool cone_cells, std::int64_t steiner_effort, const std::string& bsp_seed) {
+         py::object cancel, bool cone_cells, std::int64_t steiner_effort, const std::string& bsp_seed,
+         py::object check) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o;
         o.allow_boundary_steiner = allow_boundary_steiner;
@@ -165,7 +189,15 @@ PYBIND11_MODULE(_bsptet, m) {
         o.steiner_effort = steiner_effort;
         TetMesh mesh;
         MeshStats st;
-        run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
+        if (check.is_none()) {
+          run_without_gil(o, progress, cancel, [&]() { mesh = tetrahedralize(s, o, &st); });
+        } else {
+          const py::dict c = check.cast<py::dict>();
+          SurfaceCheckOptions co;
+          co.reorient = c.contains("reorient") && c["reorient"].cast<bool>();
+          if (c.contains("max_reported_pairs")) co.max_reported_pairs = c["max_reported_pairs"].cast<std::int64_t>();
+          run_without_gil(o, progress, cancel, [&]() { mesh = check_and_tetrahedralize(s, co, o, &st); });
+        }
         py::dict d;
         d["input_points"] = st.input_points;
         d["input_triangles"] = st.input_triangles;
@@ -212,7 +244,7 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("cone_cells") = false,
       py::arg("steiner_effort") = MeshOptions{}.steiner_effort,
-      py::arg("bsp_seed") = "auto",
+      py::arg("bsp_seed") = "auto", py::arg("check") = py::none(),
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
       "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison. "
@@ -220,7 +252,10 @@ PYBIND11_MODULE(_bsptet, m) {
       "interior Steiner point (0: no bound; MeshOptions::steiner_effort). "
       "bsp_seed: 'auto' (default), 'delaunay' (the BSP starts from the Delaunay tetrahedralization of "
       "the input points) or 'box' (one box cell, the paper's auto-partition); MeshOptions::seed; "
-      "stats['bsp_seed'] says which one the mesh came from.");
+      "stats['bsp_seed'] says which one the mesh came from. "
+      "check: None, or a dict (reorient, max_reported_pairs) to check the surface as check_surface "
+      "does, its self-intersection search beside the core (mesher.h check_and_tetrahedralize; the mesh "
+      "is made from the checked triangles, re-oriented when reorient is set).");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.
@@ -238,19 +273,7 @@ PYBIND11_MODULE(_bsptet, m) {
           py::gil_scoped_release release;
           r = check_surface(s, o);
         } catch (const SelfIntersectionError& e) {
-          py::array_t<std::int64_t> pairs({static_cast<py::ssize_t>(e.pairs().size()), static_cast<py::ssize_t>(2)});
-          auto out = pairs.mutable_unchecked<2>();
-          for (std::size_t i = 0; i < e.pairs().size(); ++i) {
-            out(static_cast<py::ssize_t>(i), 0) = e.pairs()[i][0];
-            out(static_cast<py::ssize_t>(i), 1) = e.pairs()[i][1];
-          }
-          py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
-          exc.attr("code") = error_code_name(e.code());
-          exc.attr("index") = e.index();
-          exc.attr("pairs") = pairs;
-          exc.attr("complete") = e.complete();
-          PyErr_SetObject(input_error.ptr(), exc.ptr());
-          throw py::error_already_set();
+          raise_self_intersection(e);
         }
         py::array_t<std::int64_t> tri({static_cast<py::ssize_t>(r.tri.size() / 3), static_cast<py::ssize_t>(3)});
         std::copy(r.tri.begin(), r.tri.end(), tri.mutable_data());

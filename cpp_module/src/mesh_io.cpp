@@ -1,12 +1,14 @@
 #include "bsptet/mesh_io.h"
 
 #include <algorithm>
+#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "bsptet/errors.h"
@@ -16,20 +18,27 @@ namespace bsptet {
 namespace {
 
 std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(ErrorCode::kBadArgument, "read", -1, path + ": cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw InputError(ErrorCode::kBadArgument, "read", -1, path + ": cannot open the file");
+  std::string text;
+  char buf[1 << 16];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw InputError(ErrorCode::kBadArgument, "read", -1, path + ": cannot read the file");
+  return text;
 }
+
+// The C locale's white space (std::isspace without the locale lookup).
+inline bool is_space(char c) { return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // Whitespace tokenizer that skips '#' comments and knows the line of each token.
 class Tokens {
  public:
   Tokens(const std::string& text, std::string name) : text_(text), name_(std::move(name)) {}
-  bool next(std::string& tok) {
+  bool next(std::string_view& tok) {
     for (;;) {
-      while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) {
+      while (pos_ < text_.size() && is_space(text_[pos_])) {
         if (text_[pos_] == '\n') ++line_;
         ++pos_;
       }
@@ -41,33 +50,44 @@ class Tokens {
     }
     if (pos_ >= text_.size()) return false;
     const std::size_t start = pos_;
-    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_])) && text_[pos_] != '#')
+    while (pos_ < text_.size() && !is_space(text_[pos_]) && text_[pos_] != '#')
       ++pos_;
-    tok.assign(text_, start, pos_ - start);
+    tok = std::string_view(text_).substr(start, pos_ - start);
     return true;
   }
   std::string where() const { return name_ + ":" + std::to_string(line_); }
   [[noreturn]] void fail(const std::string& what) const {
     throw InputError(ErrorCode::kBadArgument, "read", -1, where() + ": " + what);
   }
-  std::string need(const char* what) {
-    std::string t;
+  std::string_view need(const char* what) {
+    std::string_view t;
     if (!next(t)) fail(std::string("the file ends where ") + what + " was expected");
     return t;
   }
+  // Numbers as strtoll / strtod read them (from_chars first: no copy, no locale; strtod for what
+  // it does not take, such as a leading '+' or hexadecimal floats).
   long long integer(const char* what) {
-    const std::string t = need(what);
-    char* end = nullptr;
-    const long long v = std::strtoll(t.c_str(), &end, 10);
-    if (end == t.c_str() || *end != '\0') fail(std::string("expected ") + what + ", found '" + t + "'");
+    const std::string_view t = need(what);
+    long long v = 0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec == std::errc() && end == t.data() + t.size()) return v;
+    const std::string copy(t);
+    char* stop = nullptr;
+    v = std::strtoll(copy.c_str(), &stop, 10);
+    if (stop == copy.c_str() || *stop != '\0') fail(std::string("expected ") + what + ", found '" + copy + "'");
     return v;
   }
   double real(const char* what) {
-    const std::string t = need(what);
-    char* end = nullptr;
-    const double v = std::strtod(t.c_str(), &end);
-    if (end == t.c_str() || *end != '\0') fail(std::string("expected ") + what + ", found '" + t + "'");
-    if (!std::isfinite(v)) fail(std::string("non-finite ") + what + " '" + t + "'");
+    const std::string_view t = need(what);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec != std::errc() || end != t.data() + t.size()) {
+      const std::string copy(t);
+      char* stop = nullptr;
+      v = std::strtod(copy.c_str(), &stop);
+      if (stop == copy.c_str() || *stop != '\0') fail(std::string("expected ") + what + ", found '" + copy + "'");
+    }
+    if (!std::isfinite(v)) fail(std::string("non-finite ") + what + " '" + std::string(t) + "'");
     return v;
   }
   void skip_rest_of_line() {
@@ -91,8 +111,8 @@ std::string fmt(double v) {
 
 SurfaceMesh parse_off(const std::string& text, const std::string& name) {
   Tokens tk(text, name);
-  const std::string head = tk.need("the OFF header");
-  if (head != "OFF") tk.fail("not an OFF file (first word '" + head.substr(0, 20) + "')");
+  const std::string_view head = tk.need("the OFF header");
+  if (head != "OFF") tk.fail("not an OFF file (first word '" + std::string(head.substr(0, 20)) + "')");
   const long long nv = tk.integer("the vertex count"), nf = tk.integer("the face count");
   tk.integer("the edge count");
   if (nv < 0 || nf < 0 || nv > INT32_MAX || nf > INT32_MAX) tk.fail("invalid vertex or face count");

@@ -697,8 +697,10 @@ class TetComplex {
   /// RETETRAHEDRALIZE (header comment): removes the interior Steiner point v by filling a cavity
   /// around it (v's star grown by `layers` layers of tets that share a face's three vertices with
   /// it) with new tets over the cavity's boundary vertices only, found by a depth-first search over
-  /// the front (the boundary chain of what is left to fill) with at most `max_nodes` steps.
-  bool retetrahedralize(Index v, int layers, std::size_t max_tets, std::size_t max_nodes) {
+  /// the front (the boundary chain of what is left to fill) with at most `steps_left` steps, which
+  /// it decreases by the steps taken.
+  bool retetrahedralize(Index v, int layers, std::size_t max_tets, std::size_t& steps_left) {
+    const std::size_t max_nodes = steps_left;
     if (v < np_ || !vb_[v].empty() || vt_[v].empty()) return false;
     std::vector<Index> cav = vt_[v];
     std::sort(cav.begin(), cav.end());
@@ -793,7 +795,9 @@ class TetComplex {
       }
       return false;
     };
-    if (!search()) return false;
+    const bool filled = search();
+    steps_left -= std::min(nodes, max_nodes);
+    if (!filled) return false;
     if (!tets_are_new(repl, cav)) return false;
     std::int64_t gone = 0;
     {
@@ -1369,8 +1373,9 @@ std::vector<std::array<Index, 4>> remove_steiner_points(ImplicitGeometry& geo, c
     for (Index v : steiner_vertices()) {
       check_cancel();
       if (!mesh.used(v) || !mesh.labels(v).empty()) continue;
-      for (int layers = 0; layers <= 5 && affordable(v); ++layers)
-        if (charged(v, [&] { return mesh.retetrahedralize(v, layers, 120, 1000); })) {
+      std::size_t steps = 1000;  // shared by the six searches (steiner_removal.h)
+      for (int layers = 0; layers <= 5 && affordable(v) && steps > 0; ++layers)
+        if (charged(v, [&] { return mesh.retetrahedralize(v, layers, 120, steps); })) {
           ++st.collapsed;
           break;
         }

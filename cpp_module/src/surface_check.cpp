@@ -144,7 +144,60 @@ bool inside_shell(const SurfaceMesh& s, const std::vector<Index>& tri, const She
                      "could not find a ray that decides whether a shell lies inside another; please report it");
 }
 
+
+// Step 9 on the surface `m` whose coincident points are merged; `input_tri` are the caller's
+// triangles (the message names their vertex indices).
+void self_intersections_of_merged(const SurfaceMesh& m, const std::vector<Index>& input_tri,
+                                  const SurfaceCheckOptions& options) {
+  bool complete = true;
+  auto pairs = find_self_intersections(m, std::max<std::int64_t>(1, options.max_reported_pairs), &complete);
+  if (!pairs.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < pairs.size() && i < 5; ++i)
+      list += (i ? ", " : "") + std::to_string(pairs[i][0]) + " and " + std::to_string(pairs[i][1]);
+    if (pairs.size() > 5) list += ", ...";
+    const std::string count = (complete ? "" : "at least ") + std::to_string(pairs.size());
+    const Index first = pairs[0][0];
+    // The message first: the pairs are moved into the exception.
+    const std::string message =
+        "the surface intersects itself: " + count + (pairs.size() == 1 ? " pair" : " pairs") +
+        " of triangles cross or touch (triangles " + list + "); " + tri_str(input_tri, pairs[0][0]) + " meets " +
+        tri_str(input_tri, pairs[0][1]) + ". Repair the surface (fembsptet mesh --write-intersections FILE "
+        "writes these triangles out for viewing)";
+    throw SelfIntersectionError(first, message, std::move(pairs), complete);
+  }
+}
+
 }  // namespace
+
+SurfaceMesh merge_coincident_points(const SurfaceMesh& in, std::int64_t* merged) {
+  const Index np = in.num_points();
+  std::vector<Index> order(static_cast<std::size_t>(np));
+  for (Index i = 0; i < np; ++i) order[i] = i;
+  auto coords = [&](Index i) {
+    return std::array<double, 3>{in.xyz[3 * i] + 0.0, in.xyz[3 * i + 1] + 0.0, in.xyz[3 * i + 2] + 0.0};
+  };
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) {
+    const auto ca = coords(a), cb = coords(b);
+    return ca != cb ? ca < cb : a < b;
+  });
+  std::vector<Index> canon(static_cast<std::size_t>(np));
+  std::int64_t count = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool same = k > 0 && coords(order[k]) == coords(order[k - 1]);
+    canon[order[k]] = same ? canon[order[k - 1]] : order[k];
+    count += same;
+  }
+  if (merged) *merged = count;
+  SurfaceMesh out = in;
+  if (count > 0)
+    for (auto& v : out.tri) v = canon[v];
+  return out;
+}
+
+void check_self_intersections(const SurfaceMesh& surface, const SurfaceCheckOptions& options) {
+  self_intersections_of_merged(merge_coincident_points(surface), surface.tri, options);
+}
 
 SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOptions& options) {
   if (in.tri.size() % 3 != 0 || in.xyz.size() % 3 != 0)
@@ -179,17 +232,7 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
   SurfaceCheckResult result;
   result.tri = in.tri;
   // Points with identical coordinates are one vertex (first index wins); -0.0 equals 0.0.
-  SurfaceMesh m = in;
-  {
-    std::map<std::array<double, 3>, Index> first;
-    std::vector<Index> canon(np);
-    for (Index i = 0; i < np; ++i) {
-      const std::array<double, 3> key = {in.xyz[3 * i] + 0.0, in.xyz[3 * i + 1] + 0.0, in.xyz[3 * i + 2] + 0.0};
-      canon[i] = first.emplace(key, i).first->second;
-      result.merged_points += canon[i] != i;
-    }
-    for (auto& v : m.tri) v = canon[v];
-  }
+  const SurfaceMesh m = merge_coincident_points(in, &result.merged_points);
   // 4. degenerate triangles
   {
     Index first_bad = -1;
@@ -392,26 +435,7 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
                "; separate the parts or join them along a face");
   }
   // 9. self-intersections
-  if (options.self_intersections) {
-    bool complete = true;
-    auto pairs = find_self_intersections(m, std::max<std::int64_t>(1, options.max_reported_pairs), &complete);
-    if (!pairs.empty()) {
-      std::string list;
-      for (std::size_t i = 0; i < pairs.size() && i < 5; ++i)
-        list += (i ? ", " : "") + std::to_string(pairs[i][0]) + " and " + std::to_string(pairs[i][1]);
-      if (pairs.size() > 5) list += ", ...";
-      const std::string count = (complete ? "" : "at least ") + std::to_string(pairs.size());
-      const Index first = pairs[0][0];
-      // The message first: the pairs are moved into the exception.
-      const std::string message =
-          "the surface intersects itself: " + count + (pairs.size() == 1 ? " pair" : " pairs") +
-          " of triangles cross or touch (triangles " + list + "); " + tri_str(in.tri, pairs[0][0]) + " meets " +
-          tri_str(in.tri, pairs[0][1]) + ". Repair the surface (fembsptet mesh --write-intersections FILE "
-          "writes these triangles out for viewing)";
-      throw SelfIntersectionError(first, message,
-          std::move(pairs), complete);
-    }
-  }
+  if (options.self_intersections) self_intersections_of_merged(m, in.tri, options);
   // 10. shells face the right way
   {
     std::map<Index, std::size_t> shell_index;  // root -> position (roots ascend with their smallest triangle)

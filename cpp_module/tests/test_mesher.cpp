@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bsptet/errors.h"
 #include "bsptet/mesh_check.h"
@@ -216,4 +218,117 @@ TEST(Mesher, SteinerEffortBoundKeepsTheMeshValid) {
   EXPECT_EQ(m.tet, again.tet);
   EXPECT_GE(st_little.steiner_points, st_full.steiner_points);
   EXPECT_GT(st_little.steiner_points, st_full.steiner_points) << "joint needs the optional phases";
+}
+
+namespace {
+
+// An axis-aligned cube [x0, x0 + s]^3 appended to m (outward unless `inward`).
+void append_cube(SurfaceMesh& m, double x0, double s, bool inward = false) {
+  const Index base = m.num_points();
+  for (int i = 0; i < 8; ++i)
+    m.xyz.insert(m.xyz.end(), {x0 + s * (i & 1), x0 + s * ((i >> 1) & 1), x0 + s * ((i >> 2) & 1)});
+  const Index f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                          {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& t : f) {
+    if (inward) m.tri.insert(m.tri.end(), {base + t[0], base + t[2], base + t[1]});
+    else m.tri.insert(m.tri.end(), {base + t[0], base + t[1], base + t[2]});
+  }
+}
+
+// The first error of check_surface then tetrahedralize, one after the other ("" and kInternal
+// when both pass).
+std::pair<ErrorCode, std::string> sequential_error(const SurfaceMesh& s, const SurfaceCheckOptions& check) {
+  try {
+    SurfaceMesh c = s;
+    c.tri = check_surface(s, check).tri;
+    tetrahedralize(c);
+  } catch (const Error& e) {
+    return {e.code(), e.what()};
+  }
+  return {ErrorCode::kInternal, ""};
+}
+
+}  // namespace
+
+// check_and_tetrahedralize runs the self-intersection search beside the core: same mesh as the
+// check then the core, one after the other.
+TEST(CheckAndTetrahedralize, SameMeshAsTheCheckThenTheCore) {
+  for (const char* name : {"paper/dented_prism.off", "paper/schoenhardt.off", "corpus/pinion.off", "corpus/eight.off",
+                           "corpus/td_spike-1-10.off"}) {
+    const SurfaceMesh s = read_off(data(name));
+    SurfaceCheckOptions check;
+    check.reorient = true;  // td_spike needs it
+    SurfaceMesh c = s;
+    const SurfaceCheckResult r0 = check_surface(s, check);
+    c.tri = r0.tri;
+    const TetMesh sequential = tetrahedralize(c);
+    SurfaceCheckResult r1;
+    MeshStats st;
+    const TetMesh together = check_and_tetrahedralize(s, check, {}, &st, &r1);
+    EXPECT_EQ(together.xyz, sequential.xyz) << name;
+    EXPECT_EQ(together.tet, sequential.tet) << name;
+    EXPECT_EQ(r1.tri, r0.tri) << name;
+    EXPECT_EQ(r1.flipped_triangles, r0.flipped_triangles) << name;
+    EXPECT_EQ(st.tets, together.num_tets()) << name;
+    EXPECT_TRUE(check_mesh(c, together).valid) << name;
+  }
+}
+
+// Surfaces that cross themselves: the core meshes them meanwhile (and must neither crash nor loop:
+// the sanitizer build runs this), and the reported error is the check's, as in sequence, also when
+// a later step (shells facing inward) would fail too.
+TEST(CheckAndTetrahedralize, SelfIntersectionWinsWhateverTheCoreDoes) {
+  std::vector<std::pair<std::string, SurfaceMesh>> cases;
+  cases.push_back({"corpus/box.off", read_off(data("corpus/box.off"))});
+  cases.push_back({"corpus/cube_with_fold.off", read_off(data("corpus/cube_with_fold.off"))});
+  SurfaceMesh overlapping;
+  append_cube(overlapping, 0, 2);
+  append_cube(overlapping, 1, 2);
+  cases.push_back({"two overlapping cubes", overlapping});
+  SurfaceMesh inward_too;
+  append_cube(inward_too, 0, 2, /*inward=*/true);
+  append_cube(inward_too, 1, 2, /*inward=*/true);
+  cases.push_back({"two overlapping inward cubes", inward_too});
+  for (const auto& [name, s] : cases) {
+    const auto [code, message] = sequential_error(s, {});
+    ASSERT_EQ(code, ErrorCode::kSelfIntersection) << name << ": " << message;
+    try {
+      check_and_tetrahedralize(s, {});
+      ADD_FAILURE() << name << ": no error";
+    } catch (const SelfIntersectionError& e) {
+      EXPECT_EQ(std::string(e.what()), message) << name;
+      EXPECT_FALSE(e.pairs().empty()) << name;
+    }
+    // The core alone (it validates the surface but does not look for crossings): a mesh or a typed
+    // error, never a crash.
+    SurfaceMesh c = s;
+    try {
+      tetrahedralize(c);
+    } catch (const Error& e) {
+      EXPECT_NE(e.code(), ErrorCode::kCancelled) << name << ": " << e.what();
+    }
+  }
+  // Without crossings, a later step's error is reported as it is.
+  SurfaceMesh inward;
+  append_cube(inward, 0, 2, /*inward=*/true);
+  try {
+    check_and_tetrahedralize(inward, {});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInwardFacing) << e.what();
+  }
+}
+
+// The caller's cancellation still stops the core (the search's flag is added to it, not put in its
+// place).
+TEST(CheckAndTetrahedralize, CallerCancellationStillStops) {
+  const SurfaceMesh s = read_off(data("corpus/pinion.off"));
+  MeshOptions o;
+  o.cancelled = [] { return true; };
+  try {
+    check_and_tetrahedralize(s, {}, o);
+    ADD_FAILURE() << "no error";
+  } catch (const MeshingError& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kCancelled);
+  }
 }

@@ -19,6 +19,7 @@
 #include <map>
 #include <string>
 
+#include "bsptet/surface_check.h"
 #include "bsptet/types.h"
 
 namespace bsptet {
@@ -99,5 +100,17 @@ void validate_surface(const SurfaceMesh& surface);
 /// (code kCancelled when cancelled) otherwise. Output: every input point first (same indices,
 /// unused ones dropped and the rest renumbered), then the Steiner points.
 TetMesh tetrahedralize(const SurfaceMesh& surface, const MeshOptions& options = {}, MeshStats* stats = nullptr);
+
+/// check_surface(surface, check), then tetrahedralize the checked surface (flipped triangles
+/// reversed): the same mesh, and the same first error, as the two calls one after the other. The
+/// check's costly step, the self-intersection search (surface_check.h step 9), runs on a second
+/// thread while the core meshes; when it finds a pair the core is cancelled and its
+/// SelfIntersectionError is thrown, whatever the core did meanwhile (the core fills any closed
+/// oriented surface without crashing or looping, even one that crosses itself; its mesh is then
+/// dropped). Errors of the steps after 9 are only reported once step 9 has passed, as in
+/// check_surface. `checked` (optional) receives the check's result.
+TetMesh check_and_tetrahedralize(const SurfaceMesh& surface, const SurfaceCheckOptions& check,
+                                 const MeshOptions& options = {}, MeshStats* stats = nullptr,
+                                 SurfaceCheckResult* checked = nullptr);
 
 }  // namespace bsptet

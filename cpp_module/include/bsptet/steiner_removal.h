@@ -66,7 +66,10 @@
 //    positive (exact), and fills t: each face of t that is on the front leaves it, the reverse of
 //    each other face joins it (t is refused if the reverse of one of its faces is on the front:
 //    that side is already filled). The search ends when the front is empty (or after a bounded
-//    number of steps: then nothing changes).
+//    number of steps: then nothing changes). The k = 0..5 searches of one v share 1000 steps:
+//    each success seen on tests/data took at most 400 steps with the searches before it, while a
+//    search that fails usually runs out of steps, and six of them made most of the time of small
+//    meshes (tinytorus: 12 of its 14 ms).
 //    Why the result tiles C: as oriented 2-chains the front is always dC minus the boundaries of
 //    the tets chosen, so an empty front means sum_t dt = dC. The winding number is linear in the
 //    chain and equals a tet's indicator (a.e.) for a positive tet, so sum_t 1_t = 1_C almost

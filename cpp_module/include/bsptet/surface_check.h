@@ -74,4 +74,16 @@ class SelfIntersectionError : public InputError {
 /// Checks `surface` (see the list above). Throws InputError (SelfIntersectionError for step 9).
 SurfaceCheckResult check_surface(const SurfaceMesh& surface, const SurfaceCheckOptions& options = {});
 
+/// Step 9 alone: throws SelfIntersectionError (pairs as check_surface reports them) when two
+/// triangles of `surface` meet beyond their shared vertices. Precondition: steps 1 to 8 pass
+/// (check_surface with options.self_intersections = false returned). Reads `surface` only, so it
+/// may run on another thread while the core meshes the same surface (mesher.h
+/// check_and_tetrahedralize).
+void check_self_intersections(const SurfaceMesh& surface, const SurfaceCheckOptions& options = {});
+
+/// `surface` with the points of identical coordinates made one vertex: each triangle corner
+/// replaced by the smallest index of a point with its coordinates (-0.0 equals 0.0; no tolerance).
+/// `merged` (optional) receives how many points repeat an earlier one's coordinates.
+SurfaceMesh merge_coincident_points(const SurfaceMesh& surface, std::int64_t* merged = nullptr);
+
 }  // namespace bsptet
