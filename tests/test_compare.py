@@ -173,3 +173,34 @@ def test_native_core_row_meshes_like_the_worker_and_is_checked_from_its_files(tm
     mesh = read_tetgen(native.mesh_files[0][:-len(".node")])
     assert len(mesh.tets) == native.tets
     assert [r.mesher for r in compare(surface, size=1.0, meshers=(OURS_NATIVE,)).rows] == []
+
+
+def test_benchmark_repeats_short_runs_and_takes_their_median(monkeypatch):
+    """``run_benchmark(repeats=N)``: a run under a second is made N times (only the meshers that
+    were short), its seconds become the median; a long run is not repeated."""
+    from FemBspTet.compare import benchmark
+    from FemBspTet.compare.comparison import OURS_NATIVE, TETGEN_PY, Comparison, Row
+
+    times = {OURS_NATIVE: iter([0.030, 0.010, 0.020, 0.500, 0.015]),
+             TETGEN_PY: iter([5.0])}  # long: must not run again
+    calls = []
+
+    def fake_compare(surfaces, size=None, timeout=None, meshers=(), source=""):
+        calls.append(tuple(meshers))
+        return Comparison(source=source, input_points=0, input_triangles=0, solids=1, size=size,
+                          gmsh_size=0.0, gmsh_size_note="",
+                          rows=[Row(mesher=m, command=m, seconds=next(times[m]), nodes=8, tets=6,
+                                        steiner_interior=0, steiner_boundary=0,
+                                        min_dihedral_deg=45.0, p1_dihedral_deg=45.0,
+                                        median_dihedral_deg=60.0, max_radius_edge_ratio=0.9,
+                                        peak_rss_mb=5.0, valid=True) for m in meshers])
+
+    monkeypatch.setattr(benchmark, "compare", fake_compare)
+    entries = benchmark.run_benchmark([paper_path("dented_box")], meshers=(OURS_NATIVE, TETGEN_PY),
+                                      repeats=5)
+    rows = {r.mesher: r for r in entries[0].comparison.rows}
+    assert calls == [(OURS_NATIVE, TETGEN_PY)] + [(OURS_NATIVE,)] * 4
+    assert rows[OURS_NATIVE].seconds == 0.020  # median of 0.030 0.010 0.020 0.500 0.015
+    assert rows[TETGEN_PY].seconds == 5.0
+    text = benchmark.report_markdown(entries, "test", repeats=5)
+    assert "made 5 times" in text
