@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <unordered_map>
+#include <tuple>
 #include <utility>
 
 #include "bsptet/errors.h"
@@ -741,46 +742,58 @@ class TetComplex {
           out.push_back(p);
       return apexes.emplace(f, std::move(out)).first->second;
     };
-    // The front, and the same faces ordered by (number of apexes, face): its first element is the
-    // face the search fills next (the fewest apexes; among equals the smallest face).
-    std::map<std::array<Index, 3>, std::size_t> front;
-    std::set<std::pair<std::size_t, std::array<Index, 3>>> by_apexes;
-    auto front_insert = [&](const std::array<Index, 3>& f) {
-      const std::size_t n = candidates(f).size();
-      front.emplace(f, n);
-      by_apexes.insert({n, f});
+    // The front: a few dozen faces, each with its number of apexes, in a flat array (scans beat
+    // tree nodes at this size). The search fills next the face with the fewest apexes, among
+    // equals the smallest face.
+    struct FrontFace {
+      std::array<Index, 3> face;
+      std::size_t apexes;
     };
-    auto front_erase = [&](std::map<std::array<Index, 3>, std::size_t>::iterator it) {
-      by_apexes.erase({it->second, it->first});
-      front.erase(it);
+    std::vector<FrontFace> front;
+    auto front_find = [&](const std::array<Index, 3>& f) {
+      for (std::size_t i = 0; i < front.size(); ++i)
+        if (front[i].face == f) return static_cast<std::ptrdiff_t>(i);
+      return std::ptrdiff_t{-1};
     };
-    for (const auto& f : bnd) front_insert(canon(f));
+    auto front_insert = [&](const std::array<Index, 3>& f) { front.push_back({f, candidates(f).size()}); };
+    auto front_erase = [&](std::ptrdiff_t i) {
+      front[static_cast<std::size_t>(i)] = front.back();
+      front.pop_back();
+    };
+    for (const auto& f : bnd) {
+      const auto c = canon(f);
+      if (front_find(c) < 0) front_insert(c);
+    }
     std::vector<std::array<Index, 4>> repl;
     std::size_t nodes = 0;
     std::function<bool()> search = [&]() -> bool {
       if (front.empty()) return true;
       if (++nodes > max_nodes) return false;
-      if (by_apexes.begin()->first == 0) return false;  // a face no tet can fill: a dead end
-      const std::array<Index, 3> f = by_apexes.begin()->second;
-      const std::vector<Index> cs = candidates(f);
+      std::size_t best = 0;
+      for (std::size_t i = 1; i < front.size(); ++i)
+        if (std::tie(front[i].apexes, front[i].face) < std::tie(front[best].apexes, front[best].face)) best = i;
+      if (front[best].apexes == 0) return false;  // a face no tet can fill: a dead end
+      const std::array<Index, 3> f = front[best].face;
+      const std::vector<Index>& cs = candidates(f);  // map nodes stay put as others are added
       for (Index p : cs) {
         const std::array<Index, 4> t{f[0], f[2], f[1], p};
         // Fill t: the front loses t's faces that are on it and gains the reverse of the others.
         const std::array<std::array<Index, 3>, 4> tf = {
             {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
-        std::vector<std::pair<bool, std::array<Index, 3>>> undo;  // (removed?, face)
+        std::array<std::pair<bool, std::array<Index, 3>>, 4> undo;  // (removed?, face)
+        int undone = 0;
         bool fits = true;
         for (const auto& g : tf) {
           const auto k = canon(g), r = canon({g[0], g[2], g[1]});
-          if (auto it = front.find(k); it != front.end()) {
-            front_erase(it);
-            undo.push_back({true, k});
-          } else if (front.count(r)) {
+          if (const std::ptrdiff_t i = front_find(k); i >= 0) {
+            front_erase(i);
+            undo[undone++] = {true, k};
+          } else if (front_find(r) >= 0) {
             fits = false;  // t would lie on the filled side of r
             break;
           } else {
             front_insert(r);
-            undo.push_back({false, r});
+            undo[undone++] = {false, r};
           }
         }
         if (fits) {
@@ -788,9 +801,9 @@ class TetComplex {
           if (search()) return true;
           repl.pop_back();
         }
-        for (auto it = undo.rbegin(); it != undo.rend(); ++it)
-          if (it->first) front_insert(it->second);
-          else front_erase(front.find(it->second));
+        for (int u = undone - 1; u >= 0; --u)
+          if (undo[u].first) front_insert(undo[u].second);
+          else front_erase(front_find(undo[u].second));
         if (nodes > max_nodes) return false;
       }
       return false;
