@@ -189,6 +189,9 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
 
     BSP-assisted and exact (cpp_module/include/bsptet/mesher.h): the output boundary is the input
     triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is positive.
+    Each surface is checked first (:func:`check_surface`); the check's self-intersection search
+    runs on a second thread while the core meshes (``check_and_tetrahedralize``), with the same
+    errors as checking first.
 
     ``options`` (dict): ``allow_boundary_steiner`` (bool, default False), ``steiner_effort`` (int:
     work (exact orientation tests, cavity growth) the core may spend removing one interior Steiner

@@ -12,6 +12,7 @@
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesh_io.h"
 #include "bsptet/mesher.h"
+#include "test_shapes.h"
 
 using namespace bsptet;
 
@@ -222,19 +223,6 @@ TEST(Mesher, SteinerEffortBoundKeepsTheMeshValid) {
 
 namespace {
 
-// An axis-aligned cube [x0, x0 + s]^3 appended to m (outward unless `inward`).
-void append_cube(SurfaceMesh& m, double x0, double s, bool inward = false) {
-  const Index base = m.num_points();
-  for (int i = 0; i < 8; ++i)
-    m.xyz.insert(m.xyz.end(), {x0 + s * (i & 1), x0 + s * ((i >> 1) & 1), x0 + s * ((i >> 2) & 1)});
-  const Index f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                          {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& t : f) {
-    if (inward) m.tri.insert(m.tri.end(), {base + t[0], base + t[2], base + t[1]});
-    else m.tri.insert(m.tri.end(), {base + t[0], base + t[1], base + t[2]});
-  }
-}
-
 // The first error of check_surface then tetrahedralize, one after the other ("" and kInternal
 // when both pass).
 std::pair<ErrorCode, std::string> sequential_error(const SurfaceMesh& s, const SurfaceCheckOptions& check) {
@@ -282,12 +270,12 @@ TEST(CheckAndTetrahedralize, SelfIntersectionWinsWhateverTheCoreDoes) {
   cases.push_back({"corpus/box.off", read_off(data("corpus/box.off"))});
   cases.push_back({"corpus/cube_with_fold.off", read_off(data("corpus/cube_with_fold.off"))});
   SurfaceMesh overlapping;
-  append_cube(overlapping, 0, 2);
-  append_cube(overlapping, 1, 2);
+  bsptet_test::add_box(overlapping, 0, 2);
+  bsptet_test::add_box(overlapping, 1, 2);
   cases.push_back({"two overlapping cubes", overlapping});
   SurfaceMesh inward_too;
-  append_cube(inward_too, 0, 2, /*inward=*/true);
-  append_cube(inward_too, 1, 2, /*inward=*/true);
+  bsptet_test::add_box(inward_too, 0, 2, /*inward=*/true);
+  bsptet_test::add_box(inward_too, 1, 2, /*inward=*/true);
   cases.push_back({"two overlapping inward cubes", inward_too});
   for (const auto& [name, s] : cases) {
     const auto [code, message] = sequential_error(s, {});
@@ -310,7 +298,7 @@ TEST(CheckAndTetrahedralize, SelfIntersectionWinsWhateverTheCoreDoes) {
   }
   // Without crossings, a later step's error is reported as it is.
   SurfaceMesh inward;
-  append_cube(inward, 0, 2, /*inward=*/true);
+  bsptet_test::add_box(inward, 0, 2, /*inward=*/true);
   try {
     check_and_tetrahedralize(inward, {});
     ADD_FAILURE() << "no error";
