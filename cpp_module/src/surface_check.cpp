@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <map>
 #include <numeric>
+#include <tuple>
+#include <utility>
 
 #include "bsptet/exact_float.h"
 #include "bsptet/predicates.h"
@@ -57,6 +59,24 @@ struct EdgeUse {
   Index lo, hi, t;
   bool forward;
 };
+
+// Sorts `v` as std::sort(v, less) would, for a `less` that orders first by bucket(x) in [0, n):
+// a counting sort into the buckets, then each bucket (a vertex's edges or corners: a few) sorted.
+// Linear in |v| + n: on a structured surface of 10^6 triangles std::sort fell back to heap sort
+// and made most of this check's time.
+template <class T, class Bucket, class Less>
+void sort_by_buckets(std::vector<T>& v, std::size_t n, Bucket bucket, Less less) {
+  std::vector<std::size_t> start(n + 1, 0);
+  for (const T& x : v) ++start[static_cast<std::size_t>(bucket(x)) + 1];
+  for (std::size_t b = 0; b < n; ++b) start[b + 1] += start[b];
+  std::vector<T> out(v.size());
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (const T& x : v) out[fill[static_cast<std::size_t>(bucket(x))]++] = x;
+  for (std::size_t b = 0; b < n; ++b)
+    if (start[b + 1] - start[b] > 1)
+      std::sort(out.begin() + static_cast<std::ptrdiff_t>(start[b]), out.begin() + static_cast<std::ptrdiff_t>(start[b + 1]), less);
+  v = std::move(out);
+}
 
 // Sign of the signed volume enclosed by the triangles `tris` of `s` (6 x volume, in any case the
 // sign): sum of det[a - o, b - o, c - o] over the triangles, o a fixed point. A floating-point sum
@@ -269,7 +289,8 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
       std::sort(k.begin(), k.end());
       keys[t] = {k, t};
     }
-    std::sort(keys.begin(), keys.end());
+    sort_by_buckets(keys, static_cast<std::size_t>(np), [](const auto& kt) { return kt.first[0]; },
+                    [](const auto& a, const auto& b) { return a < b; });
     Index dup = -1, of = -1;
     std::int64_t count = 0;
     for (std::size_t i = 1; i < keys.size(); ++i)
@@ -295,9 +316,8 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
       const Index a = m.tri[3 * t + k], b = m.tri[3 * t + (k + 1) % 3];
       uses.push_back({std::min(a, b), std::max(a, b), t, a < b});
     }
-  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
-    return std::tie(x.lo, x.hi, x.t) < std::tie(y.lo, y.hi, y.t);
-  });
+  sort_by_buckets(uses, static_cast<std::size_t>(np), [](const EdgeUse& u) { return u.lo; },
+                  [](const EdgeUse& x, const EdgeUse& y) { return std::tie(x.lo, x.hi, x.t) < std::tie(y.lo, y.hi, y.t); });
   struct EdgeRun {
     std::size_t begin, end;
   };
@@ -409,7 +429,8 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
     std::vector<std::pair<Index, Index>> vertex_fan;  // (vertex, fan root)
     vertex_fan.reserve(static_cast<std::size_t>(nt) * 3);
     for (Index c = 0; c < 3 * nt; ++c) vertex_fan.push_back({m.tri[c], corners.find(c)});
-    std::sort(vertex_fan.begin(), vertex_fan.end());
+    sort_by_buckets(vertex_fan, static_cast<std::size_t>(np), [](const auto& vf) { return vf.first; },
+                    [](const auto& a, const auto& b) { return a < b; });
     vertex_fan.erase(std::unique(vertex_fan.begin(), vertex_fan.end()), vertex_fan.end());
     Index bad = -1;
     std::int64_t count = 0, fans = 0;
