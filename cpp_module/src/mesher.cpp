@@ -237,9 +237,10 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
 void validate_surface(const SurfaceMesh& s) { validated_surface(s); }
 
 // `seeded` (may be null) is set as soon as the complex exists: did this attempt use the Delaunay
-// seed (so that tetrahedralize knows what a failure means)?
+// seed (so that tetrahedralize knows what a failure means)? `surface_checked`: check_surface
+// passed on `input` (check_and_tetrahedralize), so validate_surface's weaker checks are skipped.
 static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats,
-                                   bool* seeded = nullptr) {
+                                   bool surface_checked, bool* seeded) {
   const auto t_start = Clock::now();
   MeshStats st;
   // Between stages too (the BSP and the Steiner removal also poll inside theirs).
@@ -257,7 +258,7 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
 
   auto t0 = Clock::now();
   progress("checking the input", 0);
-  const SurfaceMesh surface = validated_surface(input);
+  const SurfaceMesh surface = surface_checked ? merge_coincident_points(input) : validated_surface(input);
   stage_time("input_check", t0);
 
   t0 = Clock::now();
@@ -378,7 +379,9 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   return mesh;
 }
 
-TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+// tetrahedralize (header), its retries; `surface_checked` as in tetrahedralize_once.
+static TetMesh tetrahedralize_attempts(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats,
+                                       bool surface_checked) {
   const auto t_start = Clock::now();
   // The Steiner removal can get stuck on a surface point it cannot move inside (a fan of slivers
   // from planes that pass within rounding of each other, docs/core-design.md). Another complex has
@@ -410,7 +413,7 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
     bool seeded = false;
     try {
       MeshStats st;
-      TetMesh mesh = tetrahedralize_once(input, attempts[k], &st, &seeded);
+      TetMesh mesh = tetrahedralize_once(input, attempts[k], &st, surface_checked, &seeded);
       if (k == 0) first_seeded = seeded;
       if (k > 0) {
         st.retries = static_cast<std::int64_t>(k);
@@ -440,6 +443,10 @@ TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, Mes
   throw MeshingError(ErrorCode::kInternal, "mesher", -1, "no attempt left");  // not reached
 }
 
+TetMesh tetrahedralize(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats) {
+  return tetrahedralize_attempts(input, options, stats, false);
+}
+
 TetMesh check_and_tetrahedralize(const SurfaceMesh& input, const SurfaceCheckOptions& check,
                                  const MeshOptions& options, MeshStats* stats, SurfaceCheckResult* checked) {
   SurfaceCheckOptions quick = check;
@@ -457,7 +464,7 @@ TetMesh check_and_tetrahedralize(const SurfaceMesh& input, const SurfaceCheckOpt
   SurfaceMesh surface = input;
   surface.tri = result.tri;
   if (!check.self_intersections) {
-    TetMesh mesh = tetrahedralize(surface, options, stats);
+    TetMesh mesh = tetrahedralize_attempts(surface, options, stats, true);
     if (checked) *checked = std::move(result);
     return mesh;
   }
@@ -490,7 +497,7 @@ TetMesh check_and_tetrahedralize(const SurfaceMesh& input, const SurfaceCheckOpt
   TetMesh mesh;
   std::exception_ptr mesh_error;
   try {
-    mesh = tetrahedralize(surface, o, stats);
+    mesh = tetrahedralize_attempts(surface, o, stats, true);
   } catch (...) {
     mesh_error = std::current_exception();
   }

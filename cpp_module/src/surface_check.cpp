@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <tuple>
@@ -164,7 +165,6 @@ bool inside_shell(const SurfaceMesh& s, const std::vector<Index>& tri, const She
                      "could not find a ray that decides whether a shell lies inside another; please report it");
 }
 
-
 // Step 9 on the surface `m` whose coincident points are merged; `input_tri` are the caller's
 // triangles (the message names their vertex indices).
 void self_intersections_of_merged(const SurfaceMesh& m, const std::vector<Index>& input_tri,
@@ -289,8 +289,7 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
       std::sort(k.begin(), k.end());
       keys[t] = {k, t};
     }
-    sort_by_buckets(keys, static_cast<std::size_t>(np), [](const auto& kt) { return kt.first[0]; },
-                    [](const auto& a, const auto& b) { return a < b; });
+    sort_by_buckets(keys, static_cast<std::size_t>(np), [](const auto& kt) { return kt.first[0]; }, std::less<>());
     Index dup = -1, of = -1;
     std::int64_t count = 0;
     for (std::size_t i = 1; i < keys.size(); ++i)
@@ -429,8 +428,7 @@ SurfaceCheckResult check_surface(const SurfaceMesh& in, const SurfaceCheckOption
     std::vector<std::pair<Index, Index>> vertex_fan;  // (vertex, fan root)
     vertex_fan.reserve(static_cast<std::size_t>(nt) * 3);
     for (Index c = 0; c < 3 * nt; ++c) vertex_fan.push_back({m.tri[c], corners.find(c)});
-    sort_by_buckets(vertex_fan, static_cast<std::size_t>(np), [](const auto& vf) { return vf.first; },
-                    [](const auto& a, const auto& b) { return a < b; });
+    sort_by_buckets(vertex_fan, static_cast<std::size_t>(np), [](const auto& vf) { return vf.first; }, std::less<>());
     vertex_fan.erase(std::unique(vertex_fan.begin(), vertex_fan.end()), vertex_fan.end());
     Index bad = -1;
     std::int64_t count = 0, fans = 0;

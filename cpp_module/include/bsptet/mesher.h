@@ -108,7 +108,8 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const MeshOptions& options = 
 /// SelfIntersectionError is thrown, whatever the core did meanwhile (the core fills any closed
 /// oriented surface without crashing or looping, even one that crosses itself; its mesh is then
 /// dropped). Errors of the steps after 9 are only reported once step 9 has passed, as in
-/// check_surface. `checked` (optional) receives the check's result.
+/// check_surface (the core does not repeat its own, weaker input check). `checked` (optional)
+/// receives the check's result.
 TetMesh check_and_tetrahedralize(const SurfaceMesh& surface, const SurfaceCheckOptions& check,
                                  const MeshOptions& options = {}, MeshStats* stats = nullptr,
                                  SurfaceCheckResult* checked = nullptr);
