@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <unordered_set>
@@ -28,13 +29,29 @@ BspComplex::BspComplex(ImplicitGeometry& geo, const SurfaceMesh& surface, std::v
     make_box();
 }
 
+FaceBox FaceBox::enclosing(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  FaceBox b;
+  for (int k = 0; k < 3; ++k) {
+    // The cast rounds to nearest; one step outward where it went inward. Comparisons of a float
+    // with a double are exact, and the steps saturate at +-FLT_MAX / +-infinity outward.
+    float l = static_cast<float>(lo[k]), h = static_cast<float>(hi[k]);
+    if (static_cast<double>(l) > lo[k]) l = std::nextafter(l, -std::numeric_limits<float>::infinity());
+    if (static_cast<double>(h) < hi[k]) h = std::nextafter(h, std::numeric_limits<float>::infinity());
+    if (!std::isfinite(l) || !std::isfinite(h)) return FaceBox{};  // beyond floats: no box
+    b.lo[k] = l;
+    b.hi[k] = h;
+  }
+  return b;
+}
+
 Index BspComplex::new_face(BspFace f) {
-  f.box.ok = !f.verts.empty();
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  FaceBox box;  // not ok unless every vertex has a box
+  bool ok = !f.verts.empty();
+  std::array<double, 3> lo{{INFINITY, INFINITY, INFINITY}}, hi{{-INFINITY, -INFINITY, -INFINITY}};
   for (Index v : f.verts) {
     const std::array<Interval, 3>* b = geo_.vertex_box(v);
     if (!b) {
-      f.box.ok = false;
+      ok = false;
       break;
     }
     for (int k = 0; k < 3; ++k) {
@@ -42,9 +59,9 @@ Index BspComplex::new_face(BspFace f) {
       hi[k] = std::max(hi[k], (*b)[k].hi());
     }
   }
-  if (f.box.ok)
-    for (int k = 0; k < 3; ++k) f.box.box[k] = Interval(lo[k], hi[k]);
+  if (ok) box = FaceBox::enclosing(lo, hi);
   faces_.push_back(std::move(f));
+  face_boxes_.push_back(box);
   const Index id = static_cast<Index>(faces_.size() - 1);
   register_edges(id);
   return id;
@@ -58,11 +75,11 @@ void BspComplex::register_edges(Index f) {
 void BspComplex::unregister_edges(Index f) {
   const auto& v = faces_[f].verts;
   for (std::size_t i = 0; i < v.size(); ++i) {
-    auto it = edge_faces_.find(edge_key(v[i], v[(i + 1) % v.size()]));
-    if (it == edge_faces_.end()) continue;
-    auto& list = it->second;
-    list.erase(std::remove(list.begin(), list.end(), f), list.end());
-    if (list.empty()) edge_faces_.erase(it);
+    const std::uint64_t key = edge_key(v[i], v[(i + 1) % v.size()]);
+    EdgeFaceList* list = edge_faces_.find(key);
+    if (!list) continue;
+    list->remove(f);
+    if (list->empty()) edge_faces_.erase(key);
   }
 }
 
@@ -120,10 +137,10 @@ void BspComplex::make_box() {
       cells_[0].boxes.push_back(face_box(id));
     }
   // Box edges: the two box planes through each.
-  for (const auto& [key, users] : edge_faces_) {
+  edge_faces_.for_each([&](std::uint64_t key, const EdgeFaceList& users) {
     if (users.size() != 2) throw MeshingError(ErrorCode::kInternal, "bsp", -1, "box edge not shared by two faces");
     edge_line_[key] = {faces_[users[0]].plane, faces_[users[1]].plane};
-  }
+  });
 }
 
 void BspComplex::classify_triangle(Index t, Index p, int& mn, int& mx) {
@@ -175,19 +192,18 @@ Index BspComplex::choose_plane(Index c) {
 }
 
 std::array<Index, 2> BspComplex::edge_line(Index u, Index w) const {
-  auto it = edge_line_.find(edge_key(u, w));
-  if (it == edge_line_.end())
-    throw MeshingError(ErrorCode::kInternal, "bsp", u, "edge without its supporting planes");
-  return it->second;
+  const std::array<Index, 2>* line = edge_line_.find(edge_key(u, w));
+  if (!line) throw MeshingError(ErrorCode::kInternal, "bsp", u, "edge without its supporting planes");
+  return *line;
 }
 
 void BspComplex::split_edge(Index u, Index w, Index x) {
   const std::array<Index, 2> line = edge_line(u, w);
   edge_line_[edge_key(u, x)] = line;
   edge_line_[edge_key(x, w)] = line;
-  auto it = edge_faces_.find(edge_key(u, w));
-  if (it == edge_faces_.end()) return;
-  const std::vector<Index> users = it->second;  // copy: registration changes the map
+  const EdgeFaceList* list = edge_faces_.find(edge_key(u, w));
+  if (!list) return;
+  const std::vector<Index> users = list->to_vector();  // copy: registration changes the map
   for (Index g : users) {
     if (face_untouched(g) >= 0)
       throw MeshingError(ErrorCode::kInternal, "bsp", g, "a split reached an edge of an untouched seed tet");
@@ -287,8 +303,8 @@ Index BspComplex::split_cell(Index c, Index p) {
   std::vector<signed char>& face_side = face_side_;
   face_side.assign(faces.size(), 0);
   for (std::size_t fi = 0; fi < faces.size(); ++fi) {
-    if (boxes[fi].ok) {
-      const Sign bs = geo_.side_of_box(p, boxes[fi].box);
+    if (boxes[fi].ok()) {
+      const Sign bs = geo_.side_of_box(p, boxes[fi].intervals());
       if (bs != Sign::kZero) {
         face_side[fi] = bs == Sign::kPositive ? 1 : -1;
         pos = pos || bs == Sign::kPositive;
@@ -427,7 +443,28 @@ Index BspComplex::split_cell(Index c, Index p) {
   return nid;
 }
 
+void BspComplex::require_split_data(const char* what) const {
+  if (split_data_released_)
+    throw MeshingError(ErrorCode::kInternal, "bsp", -1,
+                       std::string(what) + " after release_split_data (a bug in the caller)");
+}
+
+void BspComplex::release_split_data() {
+  split_data_released_ = true;
+  std::vector<FaceBox>().swap(face_boxes_);
+  for (BspCell& c : cells_) {
+    std::vector<FaceBox>().swap(c.boxes);
+    std::vector<Index>().swap(c.conflict);
+  }
+  edge_faces_.release();
+  edge_line_.release();
+  decltype(edge_planes_)().swap(edge_planes_);
+  std::vector<std::array<Interval, 3>>().swap(tri_box_);
+  std::vector<signed char>().swap(face_side_);
+}
+
 void BspComplex::build(const std::function<bool()>& cancelled, const std::function<void(double)>& progress) {
+  require_split_data("build");
   std::vector<Index> work;  // every starting cell, the lowest id on top
   for (std::size_t c = cells_.size(); c-- > 0;) work.push_back(static_cast<Index>(c));
   const double total = std::max<double>(1.0, static_cast<double>(surface_.num_triangles()));
@@ -460,6 +497,7 @@ void BspComplex::build(const std::function<bool()>& cancelled, const std::functi
 }
 
 void BspComplex::identify_input_vertices(Index first) {
+  require_split_data("identify_input_vertices");
   std::map<std::array<double, 3>, Index> input_at;
   for (Index i = 0; i < surface_.num_points(); ++i) {
     const Vec3 p = surface_.point(i);
@@ -490,14 +528,15 @@ void BspComplex::identify_input_vertices(Index first) {
     register_edges(static_cast<Index>(f));
   }
   // Edge lines move to the new keys; planes known to contain the vertex carry over.
-  std::unordered_map<std::uint64_t, std::array<Index, 2>> moved;
-  for (const auto& [key, line] : edge_line_) {
+  EdgeMap<std::array<Index, 2>> moved;
+  moved.reserve(edge_line_.size());
+  edge_line_.for_each([&](std::uint64_t key, const std::array<Index, 2>& line) {
     Index u = static_cast<Index>(key >> 32), w = static_cast<Index>(key & 0xffffffffu);
     auto iu = replace.find(u), iw = replace.find(w);
     if (iu != replace.end()) u = iu->second;
     if (iw != replace.end()) w = iw->second;
     moved[edge_key(u, w)] = line;
-  }
+  });
   edge_line_ = std::move(moved);
   for (const auto& [from, to] : replace)
     for (Index q : geo_.tpi_planes(from)) geo_.note_on_plane(to, q);
@@ -712,7 +751,7 @@ void BspComplex::overlay_covered_face(Index f, const std::vector<Index>& over, i
     // Lines of the new edges: along an edge of t.
     for (std::size_t k = 0; k < n; ++k) {
       const Index p = piece.verts[k], q = piece.verts[(k + 1) % n];
-      if (edge_line_.count(edge_key(p, q))) continue;
+      if (edge_line_.contains(edge_key(p, q))) continue;
       Index along = -1;
       for (int e = 0; e < 3 && along < 0; ++e)
         if (geo_.orient2d(tv[e], tv[(e + 1) % 3], p, axis) == Sign::kZero &&
@@ -744,6 +783,7 @@ std::vector<Index> BspComplex::faces_on_input_planes() const {
 }
 
 void BspComplex::refine_covered_faces() {
+  require_split_data("refine_covered_faces");
   // The input triangle across each input edge, to tell the edges where the surface leaves a plane
   // (patch boundaries) from those between two triangles of the same plane.
   std::unordered_map<std::uint64_t, std::array<Index, 2>> edge_tris;
@@ -789,6 +829,7 @@ void BspComplex::refine_covered_faces() {
 }
 
 void BspComplex::refine_covered_faces_along_lines() {
+  require_split_data("refine_covered_faces_along_lines");
   visit_faces_on_input_planes([&](Index f, int axis, int fo) -> Index {
     Index cover = -1;
     for (Index t : faces_[f].coplanar)

@@ -1004,6 +1004,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     // Capacity for the seed and an eighth more for the splits: growing a vector doubles it (and
     // holds old and new at once), which made these two vectors the peak of the BSP's memory.
     faces_.reserve(faces_.size() + num_faces + num_faces / 8);
+    face_boxes_.reserve(faces_.capacity());
     const auto ncells = static_cast<std::size_t>(num_cells);
     cells_.reserve(ncells + ncells / 8);
     // Edges: about (faces + vertices) / 2 for the cells' part of a tetrahedralization (Euler), so
@@ -1084,7 +1085,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     if (cell_of[t] < 0) continue;
     for (const auto& ed : kEdge) {
       const std::uint64_t key = edge_key(tets[t][ed[0]], tets[t][ed[1]]);
-      if (edge_line_.count(key)) continue;
+      if (edge_line_.contains(key)) continue;
       int other[2], m = 0;
       for (int j = 0; j < 4; ++j)
         if (j != ed[0] && j != ed[1]) other[m++] = j;

@@ -69,15 +69,17 @@ int main(int argc, char** argv) {
       o.progress = [last = std::string(), last_pct = -1](const std::string& stage, double f) mutable {
         const int pct = static_cast<int>(f * 100);
         if (stage != last) {
-          // The peak resident memory so far (Linux), at each new stage: where the peak is reached.
-          long hwm_kib = -1;
+          // The resident memory now and its peak so far (Linux), at each new stage: where the
+          // peak is reached.
+          long hwm_kib = -1, rss_kib = -1;
           if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
             char line[256];
             while (std::fgets(line, sizeof line, f))
-              if (std::sscanf(line, "VmHWM: %ld", &hwm_kib) == 1) break;
+              if (std::sscanf(line, "VmHWM: %ld", &hwm_kib) != 1) std::sscanf(line, "VmRSS: %ld", &rss_kib);
             std::fclose(f);
           }
-          if (hwm_kib >= 0) std::fprintf(stderr, "[peak memory so far %.1f MB]\n", hwm_kib / 1024.0);
+          if (hwm_kib >= 0)
+            std::fprintf(stderr, "[memory %.1f MB, peak so far %.1f MB]\n", rss_kib / 1024.0, hwm_kib / 1024.0);
         }
         if (stage != last || pct != last_pct) std::fprintf(stderr, "[%s %d%%]\n", stage.c_str(), pct);
         last = stage;

@@ -25,6 +25,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bsptet/edge_map.h"
 #include "bsptet/implicit_geometry.h"
 #include "bsptet/types.h"
 
@@ -60,12 +61,21 @@ class VertexSigns {
   std::uint32_t stamp_ = 1;
 };
 
-/// Intervals enclosing a face's vertices; ok is false when a vertex had no interval box. Cells
-/// keep a copy beside their face ids, so that a split scans its cell's boxes in order instead of
-/// visiting every face record.
+/// A box enclosing a face's vertices, in floats rounded outward (lo down, hi up: still an
+/// enclosure, a third of the memory of double intervals; a box made wider than the face's own only
+/// sends a split to the exact per-vertex test more often). ok() is false when a vertex had no
+/// interval box. Cells keep a copy beside their face ids, so that a split scans its cell's boxes
+/// in order instead of visiting every face record.
 struct FaceBox {
-  std::array<Interval, 3> box;
-  bool ok = false;
+  std::array<float, 3> lo{{1.f, 1.f, 1.f}}, hi{{0.f, 0.f, 0.f}};  ///< empty (lo > hi) when not ok
+  bool ok() const { return lo[0] <= hi[0]; }
+  /// The smallest float box enclosing [lo, hi] (double bounds, lo <= hi); not ok when a bound is
+  /// beyond the floats' range.
+  static FaceBox enclosing(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
+  /// The box as double intervals (exact: every float is a double).
+  std::array<Interval, 3> intervals() const {
+    return {Interval(lo[0], hi[0]), Interval(lo[1], hi[1]), Interval(lo[2], hi[2])};
+  }
 };
 
 struct BspFace {
@@ -74,10 +84,6 @@ struct BspFace {
   Index cell[2] = {-1, -1};     ///< [0] positive side, [1] negative side, -1 outside the box
   std::vector<Index> coplanar;  ///< input triangles on this plane that may overlap the face
   bool alive = true;
-  /// Intervals enclosing every vertex (set by new_face; still valid when a vertex is inserted on an
-  /// edge or replaced by one at the same place), so that a split can skip a face far from its
-  /// plane without deciding each vertex.
-  FaceBox box;
 };
 
 struct BspCell {
@@ -198,6 +204,11 @@ class BspComplex {
   }
   const std::vector<BspCell>& cells() const { return cells_; }
   const BspStats& stats() const { return stats_; }
+  /// After the last build, refinement and identify_input_vertices: frees what only splitting
+  /// needs (the face boxes, each cell's boxes and conflict list, the edge maps), so that the cells'
+  /// tetrahedralization does not hold them (they were a fifth of the peak memory). The faces,
+  /// cells, vertices and untouched seed tets stay. Splitting or refining afterwards throws.
+  void release_split_data();
   ImplicitGeometry& geometry() { return geo_; }
   /// The plane of each input triangle.
   const std::vector<Index>& triangle_planes() const { return tri_plane_; }
@@ -228,7 +239,9 @@ class BspComplex {
   /// the other id: the side with more faces keeps c, so fewer faces are relabelled), or -1 when p
   /// does not cut c's interior.
   Index split_cell(Index c, Index p);
-  const FaceBox& face_box(Index f) const { return faces_[f].box; }
+  const FaceBox& face_box(Index f) const { return face_boxes_[f]; }
+  /// Throws MeshingError (kInternal) when release_split_data has been called.
+  void require_split_data(const char* what) const;
   /// Cuts the edges of face f whose ends are strictly on opposite sides of plane q (`sign`),
   /// inserting the new vertex into every face that uses the edge.
   void cut_crossing_edges(Index f, Index q, VertexSigns& sign);
@@ -271,9 +284,15 @@ class BspComplex {
   std::vector<Index> tri_plane_;
   std::vector<std::array<Interval, 3>> tri_box_;  ///< each input triangle's (exact) bounding box
   std::vector<BspFace> faces_;
+  /// Parallel to faces_: intervals enclosing every vertex of the face (set by new_face; still
+  /// valid when a vertex is inserted on an edge or replaced by one at the same place), so that a
+  /// split can skip a face far from its plane without deciding each vertex.
+  std::vector<FaceBox> face_boxes_;
+  bool split_data_released_ = false;
   std::vector<BspCell> cells_;
-  std::unordered_map<std::uint64_t, std::vector<Index>> edge_faces_;
-  std::unordered_map<std::uint64_t, std::array<Index, 2>> edge_line_;
+  EdgeMap<EdgeFaceList> edge_faces_;  ///< the live faces using each edge
+  /// The two planes whose line carries each edge (entries stay after the edge is split).
+  EdgeMap<std::array<Index, 2>> edge_line_;
   BspStats stats_;
   UntouchedSeedTets untouched_;
   std::vector<Index> face_untouched_;  ///< per seed face of the complex (see face_untouched)
