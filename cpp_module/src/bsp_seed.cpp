@@ -710,6 +710,9 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     throw MeshingError(ErrorCode::kInternal, "bsp", -1, "the Delaunay seed of the input points failed");
   std::vector<std::array<Index, 4>> tets = std::move(dt.tets);
   std::vector<std::array<Index, 4>> nb = std::move(dt.nb);
+  decltype(keyed)().swap(keyed);
+  std::vector<Index>().swap(order);
+  std::vector<char>().swap(used);
   lap("seed_delaunay");
   // Is any input edge or input triangle missing from the seed? (Vertex -> tets incidence in one
   // array; flips never remove an input edge or triangle, so what is here now stays.) When nothing
@@ -847,7 +850,10 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   // face: it goes on that face's coplanar list, nothing more. Any other triangle walks over the
   // tets it meets; those whose interior it crosses (tet_triangle_relation, exact) get it on their
   // conflict list.
-  std::vector<std::vector<Index>> conflict(static_cast<std::size_t>(nt));
+  // Crossings as (tet, triangle) pairs, sorted by tet after the walks (then each tet's triangles
+  // are in increasing order, as they were found): a list per tet cost 24 bytes for every seed tet,
+  // most of them never crossed (77 MB of the seed's peak at 10^6 triangles).
+  std::vector<std::pair<Index, Index>> crossing;
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<Index> queue;
@@ -880,7 +886,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
       const int rel = tet_triangle_relation(p, tets[t], q, qid);
       if (rel == 0) continue;
       if (rel == 2) {
-        conflict[t].push_back(tr);
+        crossing.push_back({t, tr});
         if (++stats_.seed_conflicts > max_conflicts && max_conflicts >= 0) {
           stats_.seed_abandoned = true;
           lap("seed_walk");
@@ -914,6 +920,12 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     }
   }
   std::vector<std::uint32_t>().swap(seen);
+  std::sort(crossing.begin(), crossing.end());
+  // conflict_begin[t] .. conflict_begin[t + 1]: tet t's entries of `crossing`.
+  std::vector<Index> conflict_begin(static_cast<std::size_t>(nt) + 1, 0);
+  for (const auto& [t, tr] : crossing) ++conflict_begin[static_cast<std::size_t>(t) + 1];
+  for (Index t = 0; t < nt; ++t) conflict_begin[t + 1] += conflict_begin[t];
+  auto crossed = [&](Index t) { return conflict_begin[t + 1] > conflict_begin[t]; };
   lap("seed_walk");
 
   // 4. Which tets go into the complex (UntouchedSeedTets, bsp_complex.h): those with an edge of a
@@ -941,12 +953,12 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
   std::vector<char> near_crossed(static_cast<std::size_t>(nt), 0);
   std::vector<Index> planes_of;
   for (Index t = 0; t < nt; ++t) {
-    if (conflict[t].empty()) continue;
+    if (!crossed(t)) continue;
     near_crossed[t] = 1;
     for (int i = 0; i < 4; ++i)
       if (nb[t][i] >= 0) near_crossed[nb[t][i]] = 1;
     planes_of.clear();
-    for (Index tr : conflict[t]) planes_of.push_back(tri_plane_[tr]);
+    for (Index k = conflict_begin[t]; k < conflict_begin[t + 1]; ++k) planes_of.push_back(tri_plane_[crossing[k].second]);
     std::sort(planes_of.begin(), planes_of.end());
     planes_of.erase(std::unique(planes_of.begin(), planes_of.end()), planes_of.end());
     for (const auto& ed : kEdge) {
@@ -981,6 +993,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     (in ? cell_of[t] = num_cells++ : untouched_of[t] = num_untouched++);
   }
   std::vector<std::uint64_t>().swap(hot);
+  std::vector<char>().swap(hot_vertex);
+  std::vector<char>().swap(near_crossed);
   stats_.untouched_tets = num_untouched;
   stats_.leaves += num_untouched;
 
@@ -1038,7 +1052,8 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     if (cell_of[t] < 0) continue;
     BspCell& cell = cells_[cell_of[t]];
     for (int i = 0; i < 4; ++i) cell.faces.push_back(complex_face[tet_face[t][i]]);
-    cell.conflict = std::move(conflict[t]);
+    cell.conflict.reserve(static_cast<std::size_t>(conflict_begin[t + 1] - conflict_begin[t]));
+    for (Index k = conflict_begin[t]; k < conflict_begin[t + 1]; ++k) cell.conflict.push_back(crossing[k].second);
   }
   untouched_.tets.reserve(static_cast<std::size_t>(num_untouched));
   untouched_.adj.reserve(static_cast<std::size_t>(num_untouched));
