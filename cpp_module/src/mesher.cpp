@@ -240,21 +240,22 @@ SurfaceMesh validated_surface(const SurfaceMesh& s) {
 
 void validate_surface(const SurfaceMesh& s) { validated_surface(s); }
 
-// `seeded` (may be null) is set as soon as the complex exists: did this attempt use the Delaunay
-// seed (so that tetrahedralize knows what a failure means)? `surface_checked`: check_surface
-// passed on `input` (check_and_tetrahedralize), so validate_surface's weaker checks are skipped.
 // Gives the pages of freed heap memory back to the system (glibc: malloc_trim also releases free
 // pages inside the heap, not only at its top). Called once, after the seed: its temporaries (the
 // points' Delaunay, face records, walks) are freed then, and without it they stayed resident under
 // the splits' growth, whose end is the peak on inputs with many splits (the cube-sphere at 10^5
 // triangles: 218 -> 208 MB). Not after the later stages: their freed memory does not raise a later
-// peak, and pages given back are faulted in again when reused (2 to 5 % of the run on this machine).
+// peak, and pages given back are faulted in again when reused (5 to 10 % of the 10^5 CAD bottle's run
+// on this machine).
 static void return_free_memory() {
 #if defined(__GLIBC__)
   malloc_trim(0);
 #endif
 }
 
+// `seeded` (may be null) is set as soon as the complex exists: did this attempt use the Delaunay
+// seed (so that tetrahedralize knows what a failure means)? `surface_checked`: check_surface
+// passed on `input` (check_and_tetrahedralize), so validate_surface's weaker checks are skipped.
 static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& options, MeshStats* stats,
                                    bool surface_checked, bool* seeded) {
   const auto t_start = Clock::now();
