@@ -17,14 +17,6 @@
 
 using namespace bsptet;
 
-namespace {
-
-std::uint64_t key_of(Index u, Index w) {
-  if (u > w) std::swap(u, w);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
-}
-
-}  // namespace
 
 // Inserts, overwrites and erases (most of them in long probe runs: few vertices, so many keys
 // share home slots after the table fills) must leave the same contents as std::unordered_map;
@@ -40,7 +32,7 @@ TEST(EdgeMap, AgreesWithUnorderedMapUnderRandomOperations) {
     for (int op = 0; op < 20000; ++op) {
       Index u = vert(rng), w = vert(rng);
       if (u == w) continue;
-      const std::uint64_t k = key_of(u, w);
+      const std::uint64_t k = edge_key(u, w);
       const int what = static_cast<int>(rng() % 3);
       if (what < 2) {
         map[k] = {u, op};
@@ -68,10 +60,10 @@ TEST(EdgeMap, AgreesWithUnorderedMapUnderRandomOperations) {
     // Absent keys are not found, whatever their home slot.
     for (Index u = 0; u < 50; ++u)
       for (Index w = u + 1; w < 50; ++w)
-        EXPECT_EQ(map.find(key_of(u, w)) != nullptr, ref.count(key_of(u, w)) == 1);
+        EXPECT_EQ(map.find(edge_key(u, w)) != nullptr, ref.count(edge_key(u, w)) == 1);
     map.release();
     EXPECT_EQ(map.size(), 0u);
-    EXPECT_EQ(map.find(key_of(1, 2)), nullptr);
+    EXPECT_EQ(map.find(edge_key(1, 2)), nullptr);
   }
 }
 
@@ -81,7 +73,7 @@ TEST(EdgeMap, IterationOrderIsDeterministic) {
   EdgeMap<Index> a, b;
   std::mt19937 rng(7);
   for (int i = 0; i < 5000; ++i) {
-    const std::uint64_t k = key_of(static_cast<Index>(rng() % 900), static_cast<Index>(900 + rng() % 900));
+    const std::uint64_t k = edge_key(static_cast<Index>(rng() % 900), static_cast<Index>(900 + rng() % 900));
     a[k] = i;
     b[k] = i;
     if (i % 5 == 0) {
@@ -99,7 +91,7 @@ TEST(EdgeMap, IterationOrderIsDeterministic) {
 // Face lists keep registration order across the spill from the inline ids to the heap and back.
 TEST(EdgeFaceList, KeepsOrderAcrossTheSpill) {
   EdgeMap<EdgeFaceList> map;
-  const std::uint64_t k = key_of(3, 9);
+  const std::uint64_t k = edge_key(3, 9);
   std::vector<Index> ref;
   for (Index f = 0; f < 12; ++f) {
     map[k].push_back(f * 10);
@@ -107,7 +99,7 @@ TEST(EdgeFaceList, KeepsOrderAcrossTheSpill) {
     ASSERT_EQ(map[k].to_vector(), ref);
   }
   // Rehashes move the lists (inline and spilled) intact.
-  for (Index u = 10; u < 2000; ++u) map[key_of(u, u + 1)].push_back(u);
+  for (Index u = 10; u < 2000; ++u) map[edge_key(u, u + 1)].push_back(u);
   EXPECT_EQ(map.find(k)->to_vector(), ref);
   for (Index f : {110, 0, 50, 70, 20, 30, 40, 60}) {
     map[k].remove(f);
@@ -118,7 +110,7 @@ TEST(EdgeFaceList, KeepsOrderAcrossTheSpill) {
   EXPECT_EQ(map[k].size(), 4u);  // back inline
   for (Index f : {10, 80, 90, 100}) map[k].remove(f);
   EXPECT_TRUE(map[k].empty());
-  for (Index u = 10; u < 2000; ++u) EXPECT_EQ(map.find(key_of(u, u + 1))->to_vector(), std::vector<Index>{u});
+  for (Index u = 10; u < 2000; ++u) EXPECT_EQ(map.find(edge_key(u, u + 1))->to_vector(), std::vector<Index>{u});
 }
 
 // The float box encloses the double bounds (it may only be wider), at every scale; bounds past

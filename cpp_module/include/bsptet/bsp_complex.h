@@ -222,10 +222,6 @@ class BspComplex {
   void set_debug_checks(bool on) { debug_checks_ = on; }
 
  private:
-  static std::uint64_t edge_key(Index u, Index w) {
-    if (u > w) std::swap(u, w);
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
-  }
   void make_box();
   /// bsp_seed.cpp: the cells are the Delaunay tets of the used input points and the box corners;
   /// conflict lists by a walk and a separating-axis test per input triangle.

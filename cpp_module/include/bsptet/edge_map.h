@@ -3,8 +3,8 @@
 // entry costs no allocation of its own. std::unordered_map spent a node (48 bytes) and a bucket
 // pointer per edge, plus a heap array per face list: about a sixth of the BSP's peak memory.
 //
-// Contract: keys are any 64-bit value but kEmptyKey (edge keys pack two 32-bit ids, lower first,
-// and an edge's ends differ, so ~0 never occurs). Pointers into the map are invalidated by any
+// Contract: keys are any 64-bit value but kEmptyKey (edge_key below packs two 32-bit ids, lower
+// first, and an edge's ends differ, so ~0 never occurs). Pointers into the map are invalidated by any
 // insertion or erasure. Iteration (for_each) visits the slots in array order: the same sequence
 // of operations gives the same order (deterministic output).
 #pragma once
@@ -13,11 +13,18 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "bsptet/types.h"
 
 namespace bsptet {
+
+/// The key of the undirected edge (u, w), u != w: the lower id in the high 32 bits.
+inline std::uint64_t edge_key(Index u, Index w) {
+  if (u > w) std::swap(u, w);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
+}
 
 template <class V>
 class EdgeMap {
@@ -35,14 +42,14 @@ class EdgeMap {
   }
 
   V* find(std::uint64_t key) {
-    if (slots_.empty()) return nullptr;
-    for (std::size_t i = home(key);; i = (i + 1) & mask_) {
-      if (slots_[i].key == key) return &slots_[i].value;
-      if (slots_[i].key == kEmptyKey) return nullptr;
-    }
+    const std::size_t i = slot_of(key);
+    return i == kNone ? nullptr : &slots_[i].value;
   }
-  const V* find(std::uint64_t key) const { return const_cast<EdgeMap*>(this)->find(key); }
-  bool contains(std::uint64_t key) const { return find(key) != nullptr; }
+  const V* find(std::uint64_t key) const {
+    const std::size_t i = slot_of(key);
+    return i == kNone ? nullptr : &slots_[i].value;
+  }
+  bool contains(std::uint64_t key) const { return slot_of(key) != kNone; }
 
   /// The value of key, inserted as V{} when absent.
   V& operator[](std::uint64_t key) {
@@ -59,12 +66,8 @@ class EdgeMap {
   /// Removes key (if present): the entries after it in its probe run move back, so no tombstone
   /// is left and lookups stay short.
   void erase(std::uint64_t key) {
-    if (slots_.empty()) return;
-    std::size_t i = home(key);
-    for (;; i = (i + 1) & mask_) {
-      if (slots_[i].key == kEmptyKey) return;
-      if (slots_[i].key == key) break;
-    }
+    std::size_t i = slot_of(key);
+    if (i == kNone) return;
     for (std::size_t j = (i + 1) & mask_;; j = (j + 1) & mask_) {
       if (slots_[j].key == kEmptyKey) break;
       // Slot j may move to the hole i unless its home lies cyclically in (i, j].
@@ -98,6 +101,15 @@ class EdgeMap {
     std::uint64_t key = kEmptyKey;
     V value{};
   };
+  static constexpr std::size_t kNone = ~std::size_t{0};
+  /// The slot holding key, or kNone.
+  std::size_t slot_of(std::uint64_t key) const {
+    if (slots_.empty()) return kNone;
+    for (std::size_t i = home(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return i;
+      if (slots_[i].key == kEmptyKey) return kNone;
+    }
+  }
   std::size_t home(std::uint64_t key) const {
     // Fibonacci hashing: the high bits of key * 2^64 / phi spread consecutive ids.
     return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_) & mask_;
