@@ -162,6 +162,80 @@ class SeesFace {
   std::unordered_map<std::array<Index, 3>, bool, Hash> known_;
 };
 
+// The boundary of a cavity that grows by whole tets: its outward faces, in a flat hash table
+// keyed by the sorted vertex triple. Adding a tet toggles its four faces (a face it shares with
+// the cavity goes inside, the others join the boundary), so a growth step costs the faces it
+// adds, not the whole boundary: relocate's cavities grow to thousands of tets in up to 64 steps,
+// and merging a sorted boundary at every step took a third of the run on thingi10k_472042.
+// Faces are kept in the order they came (those gone inside stay, marked dead).
+class CavityBoundary {
+ public:
+  struct Face {
+    std::array<Index, 3> key;   ///< sorted vertices
+    std::array<Index, 3> face;  ///< outward orientation
+    bool alive;                 ///< on the boundary (not gone inside)
+  };
+  void clear() {
+    faces_.clear();
+    slots_.assign(16, kEmpty);
+    live_ = used_ = 0;
+  }
+  /// Adds the outward face f, or removes it when its triple is already there.
+  void toggle(const std::array<Index, 3>& f) {
+    std::array<Index, 3> key = f;
+    std::sort(key.begin(), key.end());
+    if (2 * (used_ + 1) > slots_.size()) rehash();
+    const std::size_t mask = slots_.size() - 1;
+    std::size_t i = hash(key) & mask, tomb = kNone;
+    for (;; i = (i + 1) & mask) {
+      const std::int32_t s = slots_[i];
+      if (s == kEmpty) break;
+      if (s == kTomb) {
+        if (tomb == kNone) tomb = i;
+        continue;
+      }
+      if (faces_[static_cast<std::size_t>(s)].key == key) {
+        faces_[static_cast<std::size_t>(s)].alive = false;
+        slots_[i] = kTomb;
+        --live_;
+        return;
+      }
+    }
+    if (tomb == kNone) ++used_, tomb = i;
+    slots_[tomb] = static_cast<std::int32_t>(faces_.size());
+    faces_.push_back({key, f, true});
+    ++live_;
+  }
+  std::vector<Face>& faces() { return faces_; }
+  /// Faces on the boundary now.
+  std::size_t size() const { return live_; }
+
+ private:
+  static constexpr std::int32_t kEmpty = -1, kTomb = -2;
+  static constexpr std::size_t kNone = ~std::size_t{0};
+  static std::size_t hash(const std::array<Index, 3>& k) {
+    std::uint64_t h = static_cast<std::uint32_t>(k[0]);
+    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(k[1]);
+    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(k[2]);
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+  void rehash() {
+    std::size_t cap = 16;
+    while (cap < 4 * (live_ + 1)) cap *= 2;
+    slots_.assign(cap, kEmpty);
+    for (std::size_t n = 0; n < faces_.size(); ++n) {
+      if (!faces_[n].alive) continue;
+      std::size_t i = hash(faces_[n].key) & (cap - 1);
+      while (slots_[i] != kEmpty) i = (i + 1) & (cap - 1);
+      slots_[i] = static_cast<std::int32_t>(n);
+    }
+    used_ = live_;
+  }
+  std::vector<Face> faces_;
+  std::vector<std::int32_t> slots_;
+  std::size_t live_ = 0, used_ = 0;  ///< faces alive; slots not empty (alive or tombstones)
+};
+
 // The working tet complex: tets and boundary faces with vertex -> element lists.
 class TetComplex {
  public:
@@ -587,14 +661,17 @@ class TetComplex {
       const Index wid = geo_.add_explicit_point(w);
       // Cone from w; a face w does not see is removed from the cavity's boundary by taking the tet
       // beyond it into the cavity (never across the surface), a few times at most.
+      // The cavity's tets are stamped (start_cavity); its boundary is a CavityBoundary. Whether w
+      // sees a boundary face is decided once, when the face joins the boundary, in the order of
+      // the sorted triples: a face w does not see has its tet beyond taken at once, so the faces
+      // that stay are the ones w sees. The new surface faces' answers are kept (seen_new).
       std::vector<Index> cav = cavity;
-      std::vector<FacePair> boundary = cavity_boundary;
-      // Per boundary face (parallel to `boundary`) and per new surface face: does w see it (-1 not
-      // decided yet). Kept across the growth steps (a face stays on the boundary until a tet
-      // beyond it joins), so each face is decided once, in the order of the faces (the order
-      // the cone's tets are made in).
-      std::vector<signed char> seen(boundary.size(), -1), seen_new(new_faces.size(), -1);
-      std::vector<std::array<Index, 4>> repl;
+      start_cavity(cav);
+      bnd_.clear();
+      for (const auto& pr : cavity_boundary) bnd_.toggle(pr.second);
+      std::vector<signed char> seen_new(new_faces.size(), -1);
+      std::vector<std::size_t> fresh;  // boundary faces not decided yet (indices)
+      std::size_t first_fresh = 0;
       std::vector<std::array<Index, 3>> bad;
       bool ok = false;
       const int max_grow = is_deep(attempt) ? deep_grow_limit : attempt < 12 ? grow_limit : 0;  // bounded work
@@ -603,25 +680,36 @@ class TetComplex {
         return geo_.orient3d(f[0], f[2], f[1], wid) == Sign::kPositive;
       };
       for (int grow = 0; grow <= max_grow; ++grow) {
-        // Cone from w over the cavity's bases (its boundary faces without a removed point, then
-        // the new surface faces); every face w does not see takes the tet beyond it into the cavity.
-        repl.clear();
+        // The faces that joined the boundary (all of them at first), in the order of their
+        // triples, then the new surface faces; every face w does not see is bad. With no growth
+        // left one bad face decides.
         bad.clear();
         bool stop = false;
-        auto visit = [&](const std::array<Index, 3>& f, signed char& known) {
-          if (known < 0) known = sees(f) ? 1 : 0;
-          if (known == 0) {
+        std::vector<CavityBoundary::Face>& faces = bnd_.faces();
+        fresh.clear();
+        for (std::size_t n = first_fresh; n < faces.size(); ++n)
+          if (faces[n].alive) fresh.push_back(n);
+        first_fresh = faces.size();
+        if (grow > 0)
+          std::sort(fresh.begin(), fresh.end(), [&](std::size_t a, std::size_t b) { return faces[a].key < faces[b].key; });
+        for (std::size_t n : fresh) {
+          const auto& f = faces[n].face;
+          if (is_removed(f[0]) || is_removed(f[1]) || is_removed(f[2])) continue;
+          if (!sees(f)) {
             bad.push_back(f);
-            if (grow == max_grow) stop = true;  // no growth left: one bad face decides
-          } else {
-            repl.push_back({f[0], f[2], f[1], wid});
+            if (grow == max_grow) {
+              stop = true;
+              break;
+            }
           }
-        };
-        for (std::size_t i = 0; i < boundary.size() && !stop; ++i) {
-          const auto& f = boundary[i].second;
-          if (!is_removed(f[0]) && !is_removed(f[1]) && !is_removed(f[2])) visit(f, seen[i]);
         }
-        for (std::size_t i = 0; i < new_faces.size() && !stop; ++i) visit(new_faces[i], seen_new[i]);
+        for (std::size_t i = 0; i < new_faces.size() && !stop; ++i) {
+          if (seen_new[i] < 0) seen_new[i] = sees(new_faces[i]) ? 1 : 0;
+          if (seen_new[i] == 0) {
+            bad.push_back(new_faces[i]);
+            if (grow == max_grow) stop = true;
+          }
+        }
         if (bad.empty()) {
           ok = true;
           break;
@@ -629,7 +717,7 @@ class TetComplex {
         if (grow == max_grow) break;
         std::vector<Index> add;
         for (const auto& f : bad) {
-          const Index beyond = tet_beyond(f, cav);
+          const Index beyond = tet_beyond_stamped(f);
           if (beyond < 0) {  // a surface face (or a new one): w is on its wrong side
             add.clear();
             break;
@@ -639,12 +727,30 @@ class TetComplex {
         if (add.empty() || cav.size() + add.size() > max_cavity) break;
         std::sort(add.begin(), add.end());
         add.erase(std::unique(add.begin(), add.end()), add.end());
-        boundary = merge_boundaries(boundary, boundary_pairs(add), &seen);
+        for (Index id : add) {
+          cav_stamp_[static_cast<std::size_t>(id)] = stamp_;
+          const auto& t = tets_[id];
+          for (const std::array<Index, 3>& g :
+               {std::array<Index, 3>{t[0], t[2], t[1]}, std::array<Index, 3>{t[0], t[1], t[3]},
+                std::array<Index, 3>{t[0], t[3], t[2]}, std::array<Index, 3>{t[1], t[2], t[3]}})
+            bnd_.toggle(g);
+        }
         cav.insert(cav.end(), add.begin(), add.end());
-        std::inplace_merge(cav.begin(), cav.end() - static_cast<std::ptrdiff_t>(add.size()), cav.end());
-        work += static_cast<std::int64_t>(boundary.size() + cav.size());  // the growth's own cost
+        work += static_cast<std::int64_t>(bnd_.size() + cav.size());  // the growth's own cost
       }
       if (!ok) continue;
+      // The cone from w over the boundary faces without a removed point (in the order of their
+      // triples), then over the new surface faces.
+      std::vector<const CavityBoundary::Face*> cone;
+      for (const auto& bf : bnd_.faces())
+        if (bf.alive && !is_removed(bf.face[0]) && !is_removed(bf.face[1]) && !is_removed(bf.face[2]))
+          cone.push_back(&bf);
+      std::sort(cone.begin(), cone.end(), [](const auto* a, const auto* b) { return a->key < b->key; });
+      std::vector<std::array<Index, 4>> repl;
+      repl.reserve(cone.size() + new_faces.size());
+      for (const auto* bf : cone) repl.push_back({bf->face[0], bf->face[2], bf->face[1], wid});
+      for (const auto& f : new_faces) repl.push_back({f[0], f[2], f[1], wid});
+      std::sort(cav.begin(), cav.end());
       for (Index id : cav) kill_tet(id);
       for (const auto& t : repl) add_tet(t);
       for (Index id : fset) kill_face(id);
@@ -995,30 +1101,17 @@ class TetComplex {
   /// The boundary of the union of two sets of tets without common tets, from their boundaries
   /// (boundary_pairs order): the faces of one of them only (a face of both is now inside). A
   /// cavity that grows by a few tets updates its boundary this way instead of sorting it again.
-  /// `flags` (optional, parallel to a) is carried along: kept for a's faces that stay, -1 for b's.
-  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b,
-                                                std::vector<signed char>* flags = nullptr) {
+  static std::vector<FacePair> merge_boundaries(const std::vector<FacePair>& a, const std::vector<FacePair>& b) {
     std::vector<FacePair> out;
-    std::vector<signed char> out_flags;
     out.reserve(a.size() + b.size());
-    if (flags) out_flags.reserve(a.size() + b.size());
-    auto take_a = [&](std::size_t i) {
-      out.push_back(a[i]);
-      if (flags) out_flags.push_back((*flags)[i]);
-    };
-    auto take_b = [&](std::size_t j) {
-      out.push_back(b[j]);
-      if (flags) out_flags.push_back(-1);
-    };
     std::size_t i = 0, j = 0;
     while (i < a.size() && j < b.size()) {
-      if (a[i].first < b[j].first) take_a(i++);
-      else if (b[j].first < a[i].first) take_b(j++);
+      if (a[i].first < b[j].first) out.push_back(a[i++]);
+      else if (b[j].first < a[i].first) out.push_back(b[j++]);
       else ++i, ++j;
     }
-    for (; i < a.size(); ++i) take_a(i);
-    for (; j < b.size(); ++j) take_b(j);
-    if (flags) flags->swap(out_flags);
+    out.insert(out.end(), a.begin() + static_cast<std::ptrdiff_t>(i), a.end());
+    out.insert(out.end(), b.begin() + static_cast<std::ptrdiff_t>(j), b.end());
     return out;
   }
   /// Outward boundary faces of a set of tets (sorted ids): the faces that appear once.
@@ -1039,6 +1132,26 @@ class TetComplex {
       const auto& t = tets_[id];
       if (std::find(t.begin(), t.end(), a) != t.end() && std::find(t.begin(), t.end(), b) != t.end() &&
           !std::binary_search(cav.begin(), cav.end(), id))
+        return id;
+    }
+    return -1;
+  }
+  /// Stamps the tets of a cavity (relocate), for tet_beyond_stamped.
+  void start_cavity(const std::vector<Index>& cav) {
+    if (cav_stamp_.size() < tets_.size()) cav_stamp_.resize(tets_.size(), 0);
+    if (++stamp_ == 0) std::fill(cav_stamp_.begin(), cav_stamp_.end(), 0), stamp_ = 1;
+    for (Index id : cav) cav_stamp_[static_cast<std::size_t>(id)] = stamp_;
+  }
+  /// tet_beyond for the cavity stamped by start_cavity (and the tets stamped since).
+  Index tet_beyond_stamped(const std::array<Index, 3>& f) const {
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (vt_[f[i]].size() < vt_[f[k]].size()) k = i;
+    const Index a = f[(k + 1) % 3], b = f[(k + 2) % 3];
+    for (Index id : vt_[f[k]]) {
+      const auto& t = tets_[id];
+      if (cav_stamp_[static_cast<std::size_t>(id)] != stamp_ && std::find(t.begin(), t.end(), a) != t.end() &&
+          std::find(t.begin(), t.end(), b) != t.end())
         return id;
     }
     return -1;
@@ -1092,6 +1205,9 @@ class TetComplex {
   std::vector<char> falive_;
   std::vector<std::vector<Index>> vb_;
   std::vector<std::uint64_t> version_;  ///< changes at each vertex (signature())
+  CavityBoundary bnd_;                   ///< relocate: the boundary of the cavity being grown
+  std::vector<std::uint32_t> cav_stamp_;  ///< relocate: tets stamped stamp_ are in the cavity
+  std::uint32_t stamp_ = 0;
   std::vector<Index> star_sorted_;       ///< cone_from_vertex: star_boundary_of_'s star, sorted
   std::vector<FacePair> star_boundary_;  ///< cone_from_vertex: boundary of star_boundary_of_'s star
   Index star_boundary_of_ = -1;
