@@ -26,6 +26,7 @@
 #include <functional>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -249,12 +250,20 @@ int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 
 //    its planar faces) this made the recovered edges 110 -> 750 of ~3600 and the BSP points
 //    113,000 -> 59,000 (31 s -> 17 s). Edges still missing are blocked in 3D: the cones over
 //    the ring from the removed edge's ends are not all positive (thin slabs of tets over the
-//    plane), which needs flips off the plane first; not done.
+//    plane), which needs flips off the plane first:
+//  * where the 2-3 flip is blocked (the two tets' union is not convex at an edge of their common
+//    face) or ab passes through a seed edge that planar_flip cannot replace, that edge is removed
+//    by EDGE REMOVAL over any triangulation of its ring, or where none is valid, after the
+//    removal of one of its spokes (remove_edge_deep: Si's flipnm, as in TetGen, one level deep).
+//    Session 23: recovered edges 863 -> 1090 of 1102 on triceratops, 124 -> 246 of 264 on
+//    couplingdown, 54 -> 144 of 180 on joint (whose seed the auto choice had dropped for the
+//    box); core time 0.4 to 0.6 of what it was on these.
 class SeedFlips {
  public:
   using Tet = std::array<Index, 4>;
   template <class PointOf>
-  SeedFlips(std::vector<Tet>& tets, Index num_vertices, PointOf point_of) : tets_(tets), inc_(num_vertices) {
+  SeedFlips(std::vector<Tet>& tets, Index num_vertices, PointOf point_of)
+      : tets_(tets), inc_(num_vertices), changes_(static_cast<std::size_t>(num_vertices), 0) {
     pts_.resize(static_cast<std::size_t>(num_vertices));
     for (Index v = 0; v < num_vertices; ++v) pts_[v] = point_of(v);
     alive_.assign(tets_.size(), 1);
@@ -279,9 +288,16 @@ class SeedFlips {
   }
 
   /// Tries to make (a, b) an edge with at most `max_flips` flips; true when it is one.
-  /// A failed attempt keeps its flips: each one removed a crossing of an input edge, so the
-  /// input triangles there cross fewer seed tets (fewer BSP points; undoing them measured worse).
+  /// The segment ab leaves a through a face (2-3 flip, or where that is blocked, the removal of
+  /// the blocking edge: remove_blocking_edge) or through an edge (planar_flip, or its removal:
+  /// remove_edge_deep). A failed attempt keeps its flips: each 2-3 or planar flip removed a
+  /// crossing of an input edge, so the input triangles there cross fewer seed tets (fewer BSP
+  /// points; undoing them measured worse). Undoing the edge removals of failed attempts measured
+  /// worse too (joint, anchor, couplingdown: 1.5 to 3.5 times the BSP points), though they need
+  /// not remove a crossing: at most kMaxRemovalsPerEdge per attempt (without a bound
+  /// thingi10k_112932's seed made 139,000 flips, with it 41,000, for as many recovered edges).
   bool recover_edge(Index a, Index b, int max_flips) {
+    int removals = 0;  // edge removals so far (at most kMaxRemovalsPerEdge)
     for (int it = 0; it <= max_flips; ++it) {
       if (has_edge(a, b)) return true;
       if (it == max_flips) return false;
@@ -305,7 +321,7 @@ class SeedFlips {
         }
         if (!inside) continue;
         if (zeros == 0) {
-          flipped = flip23(t, ia);
+          flipped = flip23(t, ia) || (removals < kMaxRemovalsPerEdge && remove_blocking_edge(t, ia) && ++removals);
           degenerate = !flipped;  // the segment leaves through that face: nothing else to try
         } else if (zeros == 1) {
           // Through the interior of the edge cd of the face opposite a that is not on face
@@ -313,7 +329,8 @@ class SeedFlips {
           Index c = -1, d = -1;
           for (int j = 0; j < 4; ++j)
             if (j != ia && j != zero_face) (c < 0 ? c : d) = q[j];
-          flipped = planar_flip(a, b, c, d);
+          flipped = planar_flip(a, b, c, d) ||
+                    (removals < kMaxRemovalsPerEdge && remove_edge_deep(c, d, kFlipLevels) && ++removals);
           degenerate = !flipped;
         }
       }
@@ -436,6 +453,9 @@ class SeedFlips {
     return q;
   }
   void replace(const std::vector<Index>& old_tets, const std::vector<Tet>& new_tets) {
+    if (logging_) log_.push_back({old_tets, tets_.size()});
+    for (Index t : old_tets)
+      for (Index v : tets_[t]) ++changes_[v];
     for (Index t : old_tets) {
       alive_[t] = 0;
       for (Index v : tets_[t]) {
@@ -450,6 +470,68 @@ class SeedFlips {
       for (Index v : q) inc_[v].push_back(t);
     }
     ++flips_;
+  }
+  /// Undoes the flips logged after the first `mark` (latest first): their new tets (the last ones
+  /// made) go, their old tets come back.
+  void undo_to(std::size_t mark) {
+    while (log_.size() > mark) {
+      const FlipLog& f = log_.back();
+      while (tets_.size() > f.first_new) {
+        const Index t = static_cast<Index>(tets_.size() - 1);
+        for (Index v : tets_.back()) {
+          auto& l = inc_[v];
+          l.erase(std::find(l.begin(), l.end(), t));
+          ++changes_[v];
+        }
+        tets_.pop_back();
+        alive_.pop_back();
+      }
+      for (Index t : f.old_tets) {
+        alive_[t] = 1;
+        for (Index v : tets_[t]) inc_[v].push_back(t);
+      }
+      --flips_;
+      log_.pop_back();
+    }
+  }
+  /// EDGE REMOVAL of (c, d) (any triangulation of its ring), and where that has none, first the
+  /// removal of one spoke (x, p): x = c or d, p on the ring (itself with `level` - 1 such
+  /// retries), which changes the ring (Si's flipnm, TetGen, to one level): the first spoke after
+  /// which (c, d) can go is kept with it; the flips of the others are undone.
+  bool remove_edge_deep(Index c, Index d, int level) {
+    if (remove_edge(c, d, -1, -1)) return true;
+    if (level <= 0 || edge_protected(c, d)) return false;
+    const std::vector<Index> ring = ring_apexes(c, d);
+    if (ring.size() < 3 || static_cast<int>(ring.size()) > kMaxRing) return false;
+    // It depends only on the tets at c, d and the ring's vertices: a failure is remembered with
+    // their change counters (which only grow), and not tried again while their sum is unchanged.
+    std::uint64_t signature = changes_[c] + changes_[d];
+    for (Index p : ring) signature += changes_[p];
+    const std::uint64_t key = key2(c, d);
+    if (const auto it = failed_deep_.find(key);
+        it != failed_deep_.end() && it->second == std::pair{level, signature})
+      return false;
+    const bool was_logging = logging_;
+    logging_ = true;
+    bool done = false;
+    for (std::size_t i = 0; i < ring.size() && !done; ++i)
+      for (Index x : {c, d}) {
+        const std::size_t mark = log_.size();
+        if (remove_edge_deep(x, ring[i], level - 1) && remove_edge(c, d, -1, -1)) {
+          done = true;
+          break;
+        }
+        undo_to(mark);
+      }
+    logging_ = was_logging;
+    if (!logging_) log_.clear();
+    if (!done) {
+      // The undone flips counted as changes: the signature after them.
+      std::uint64_t after = changes_[c] + changes_[d];
+      for (Index p : ring) after += changes_[p];
+      failed_deep_[key] = {level, after};
+    }
+    return done;
   }
   // Tet t and its neighbour across the face opposite vertex ia: three tets around the new edge.
   bool flip23(Index t, int ia) {
@@ -470,6 +552,25 @@ class SeedFlips {
     }
     replace({t, t2}, made);
     return true;
+  }
+  // Where flip23(t, ia) fails because the two tets' union is not convex at an edge of their
+  // common face (a new tet would not be positive), that edge is removed instead (EDGE REMOVAL,
+  // any triangulation of its ring): the segment then leaves t's successor through other faces.
+  // The first such edge that can go, in the face's order.
+  bool remove_blocking_edge(Index t, int ia) {
+    const Tet q = tets_[t];
+    const Index c = q[kFace[ia][0]], d = q[kFace[ia][1]], e = q[kFace[ia][2]];
+    if (face_protected(c, d, e)) return false;
+    const Index t2 = tet_with(c, d, e, t);
+    if (t2 < 0) return false;
+    Index f = -1;
+    for (Index v : tets_[t2])
+      if (v != c && v != d && v != e) f = v;
+    for (const auto& [x, y, z] : {std::tuple{c, d, e}, std::tuple{d, e, c}, std::tuple{e, c, d}}) {
+      if (positive(substituted(q, x, f))) continue;
+      if (remove_edge_deep(y, z, kFlipLevels)) return true;
+    }
+    return false;
   }
   // Edge (d, e) with exactly three tets around it, whose other vertices are a, b, c: replaced by
   // the two tets over face (a, b, c).
@@ -576,6 +677,7 @@ class SeedFlips {
       if (face_protected(c, d, u) || face_protected(c, d, w)) return false;
       next.push_back(even_order(tets_[t], c, d, u, w) ? std::pair{u, w} : std::pair{w, u});
     }
+    if (a < 0) a = next[0].first;  // any triangulation: the ring from any of its vertices
     std::vector<Index> p{a};
     for (int i = 1; i <= n; ++i) {
       const auto it = std::find_if(next.begin(), next.end(), [&](const auto& uw) { return uw.first == p.back(); });
@@ -586,8 +688,9 @@ class SeedFlips {
       }
       p.push_back(it->second);
     }
-    const int k = static_cast<int>(std::find(p.begin(), p.end(), e) - p.begin());
-    if (k <= 1 || k >= n - 1) return false;  // e must be a ring vertex not next to a
+    // e < 0: any triangulation (the whole polygon, p_0 .. p_{n-1}, is the sub-polygon (0, n - 1)).
+    const int k = e < 0 ? n - 1 : static_cast<int>(std::find(p.begin(), p.end(), e) - p.begin());
+    if (e >= 0 && (k <= 1 || k >= n - 1)) return false;  // e must be a ring vertex not next to a
     // ok[i][j] (i < j, j <= n; p_n = p_0): the sub-polygon p_i .. p_j has a triangulation of
     // valid triangles; via[i][j] its apex. Triangle (p_i, p_j, p_m) in ring order: tets
     // (c, p_i, p_j, p_m) and (d, p_j, p_i, p_m).
@@ -609,7 +712,7 @@ class SeedFlips {
         }
       return ok[i][j] > 0;
     };
-    if (!fill(0, k) || !fill(k, n)) return false;
+    if (!fill(0, k) || (e >= 0 && !fill(k, n))) return false;
     std::vector<Tet> made;
     std::function<void(int, int)> emit = [&](int i, int j) {
       if (j == i + 1) return;
@@ -620,7 +723,7 @@ class SeedFlips {
       emit(m, j);
     };
     emit(0, k);
-    emit(k, n);
+    if (e >= 0) emit(k, n);
     replace(ring, made);
     return true;
   }
@@ -635,6 +738,12 @@ class SeedFlips {
     return inversions % 2 == 0;
   }
   static constexpr int kMaxRing = 10;  // bounded work: rings of at most 10 tets
+  static constexpr int kFlipLevels = 1;  // remove_edge_deep's levels of spoke removals
+  static constexpr int kMaxRemovalsPerEdge = 8;  // recover_edge's edge removals per attempt
+  struct FlipLog {
+    std::vector<Index> old_tets;
+    std::size_t first_new;  ///< the flip's new tets are tets_[first_new ..] when it is the latest
+  };
 
   std::vector<Tet>& tets_;
   std::vector<std::vector<Index>> inc_;
@@ -644,6 +753,11 @@ class SeedFlips {
   std::vector<std::uint64_t> protected_edges_;
   bool protection_sorted_ = true;
   std::int64_t flips_ = 0;
+  std::vector<std::uint64_t> changes_;  ///< per vertex: how often its tets changed (flips, undos)
+  std::vector<FlipLog> log_;  ///< flips made while logging_ (remove_edge_deep), for undo_to
+  bool logging_ = false;
+  /// remove_edge_deep's failures: edge -> (level, signature)
+  std::unordered_map<std::uint64_t, std::pair<int, std::uint64_t>> failed_deep_;
 };
 
 }  // namespace
@@ -744,6 +858,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     SeedFlips flips(tets, corner0_ + 8, point_of);
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
       flips.protect_triangle(triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2));
+    std::vector<std::pair<Index, Index>> missing;
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
       for (int k = 0; k < 3; ++k) {
         const Index a = triangle_vertex(tr, k), b = triangle_vertex(tr, (k + 1) % 3);
@@ -751,7 +866,19 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
         ++stats_.seed_missing_edges;
         if (flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge))
           ++stats_.seed_recovered_edges;
+        else
+          missing.push_back({a, b});
       }
+    for (int pass = 0; pass < 2 && !missing.empty(); ++pass) {
+      std::vector<std::pair<Index, Index>> still;
+      for (const auto& [a, b] : missing)
+        if (flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge))
+          ++stats_.seed_recovered_edges;
+        else
+          still.push_back({a, b});
+      if (still.size() == missing.size()) break;
+      missing.swap(still);
+    }
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr) {
       const Index a = triangle_vertex(tr, 0), b = triangle_vertex(tr, 1), c = triangle_vertex(tr, 2);
       if (flips.has_face(a, b, c) || !flips.has_edge(a, b) || !flips.has_edge(b, c) || !flips.has_edge(c, a)) continue;
