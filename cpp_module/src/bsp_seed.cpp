@@ -533,16 +533,25 @@ class SeedFlips {
     }
     return done;
   }
+  /// The tet t2 across the face (c, d, e) of tet t opposite vertex ia, and its vertex f off that
+  /// face; false when there is none (the seed's hull) or the face is an input triangle.
+  bool across(Index t, int ia, Index& t2, Index& f) {
+    const Tet& q = tets_[t];
+    const Index c = q[kFace[ia][0]], d = q[kFace[ia][1]], e = q[kFace[ia][2]];
+    if (face_protected(c, d, e)) return false;
+    t2 = tet_with(c, d, e, t);
+    if (t2 < 0) return false;
+    f = -1;
+    for (Index v : tets_[t2])
+      if (v != c && v != d && v != e) f = v;
+    return true;
+  }
   // Tet t and its neighbour across the face opposite vertex ia: three tets around the new edge.
   bool flip23(Index t, int ia) {
     const Tet q = tets_[t];
     const Index c = q[kFace[ia][0]], d = q[kFace[ia][1]], e = q[kFace[ia][2]];
-    if (face_protected(c, d, e)) return false;
-    const Index t2 = tet_with(c, d, e, t);
-    if (t2 < 0) return false;
-    Index f = -1;
-    for (Index v : tets_[t2])
-      if (v != c && v != d && v != e) f = v;
+    Index t2, f;
+    if (!across(t, ia, t2, f)) return false;
     // Each new tet keeps one face of t through a (its other vertex replaced by f).
     std::vector<Tet> made;
     for (Index x : {c, d, e}) {
@@ -560,12 +569,8 @@ class SeedFlips {
   bool remove_blocking_edge(Index t, int ia) {
     const Tet q = tets_[t];
     const Index c = q[kFace[ia][0]], d = q[kFace[ia][1]], e = q[kFace[ia][2]];
-    if (face_protected(c, d, e)) return false;
-    const Index t2 = tet_with(c, d, e, t);
-    if (t2 < 0) return false;
-    Index f = -1;
-    for (Index v : tets_[t2])
-      if (v != c && v != d && v != e) f = v;
+    Index t2, f;
+    if (!across(t, ia, t2, f)) return false;
     for (const auto& [x, y, z] : {std::tuple{c, d, e}, std::tuple{d, e, c}, std::tuple{e, c, d}}) {
       if (positive(substituted(q, x, f))) continue;
       if (remove_edge_deep(y, z, kFlipLevels)) return true;

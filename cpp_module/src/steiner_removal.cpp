@@ -1120,10 +1120,11 @@ class TetComplex {
     for (const auto& p : boundary_pairs(cav)) out.push_back(p.second);
     return out;
   }
-  /// The tet across face f from the cavity `cav` (sorted), or -1 (a surface face).
+  /// The tet across face f from a cavity (`in_cavity(id)`), or -1 (a surface face).
   /// A face has at most two tets and one is in the cavity, so the answer does not depend on which
   /// vertex's list is searched: the shortest one (input points can have thousands of tets).
-  Index tet_beyond(const std::array<Index, 3>& f, const std::vector<Index>& cav) const {
+  template <class InCavity>
+  Index tet_beyond_if(const std::array<Index, 3>& f, InCavity&& in_cavity) const {
     int k = 0;
     for (int i = 1; i < 3; ++i)
       if (vt_[f[i]].size() < vt_[f[k]].size()) k = i;
@@ -1131,10 +1132,14 @@ class TetComplex {
     for (Index id : vt_[f[k]]) {
       const auto& t = tets_[id];
       if (std::find(t.begin(), t.end(), a) != t.end() && std::find(t.begin(), t.end(), b) != t.end() &&
-          !std::binary_search(cav.begin(), cav.end(), id))
+          !in_cavity(id))
         return id;
     }
     return -1;
+  }
+  /// tet_beyond_if for the cavity `cav` (sorted).
+  Index tet_beyond(const std::array<Index, 3>& f, const std::vector<Index>& cav) const {
+    return tet_beyond_if(f, [&](Index id) { return std::binary_search(cav.begin(), cav.end(), id); });
   }
   /// Stamps the tets of a cavity (relocate), for tet_beyond_stamped.
   void start_cavity(const std::vector<Index>& cav) {
@@ -1142,19 +1147,9 @@ class TetComplex {
     if (++stamp_ == 0) std::fill(cav_stamp_.begin(), cav_stamp_.end(), 0), stamp_ = 1;
     for (Index id : cav) cav_stamp_[static_cast<std::size_t>(id)] = stamp_;
   }
-  /// tet_beyond for the cavity stamped by start_cavity (and the tets stamped since).
+  /// tet_beyond_if for the cavity stamped by start_cavity (and the tets stamped since).
   Index tet_beyond_stamped(const std::array<Index, 3>& f) const {
-    int k = 0;
-    for (int i = 1; i < 3; ++i)
-      if (vt_[f[i]].size() < vt_[f[k]].size()) k = i;
-    const Index a = f[(k + 1) % 3], b = f[(k + 2) % 3];
-    for (Index id : vt_[f[k]]) {
-      const auto& t = tets_[id];
-      if (cav_stamp_[static_cast<std::size_t>(id)] != stamp_ && std::find(t.begin(), t.end(), a) != t.end() &&
-          std::find(t.begin(), t.end(), b) != t.end())
-        return id;
-    }
-    return -1;
+    return tet_beyond_if(f, [&](Index id) { return cav_stamp_[static_cast<std::size_t>(id)] == stamp_; });
   }
   /// Topological safeguard: no new tet duplicates a tet outside the cavity.
   bool tets_are_new(const std::vector<std::array<Index, 4>>& repl, const std::vector<Index>& cav) const {
