@@ -275,9 +275,9 @@ class SeedFlips {
     std::array<Index, 3> k{{a, b, c}};
     std::sort(k.begin(), k.end());
     protected_faces_.push_back(key3(k));
-    protected_edges_.push_back(key2(a, b));
-    protected_edges_.push_back(key2(b, c));
-    protected_edges_.push_back(key2(a, c));
+    protected_edges_.push_back(edge_key(a, b));
+    protected_edges_.push_back(edge_key(b, c));
+    protected_edges_.push_back(edge_key(a, c));
     protection_sorted_ = false;
   }
 
@@ -399,10 +399,6 @@ class SeedFlips {
       if (q[i] == v) return i;
     return -1;
   }
-  static std::uint64_t key2(Index a, Index b) {
-    if (a > b) std::swap(a, b);
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-  }
   static std::array<Index, 3> key3(std::array<Index, 3> k) {
     std::sort(k.begin(), k.end());
     return k;
@@ -418,7 +414,7 @@ class SeedFlips {
   }
   bool edge_protected(Index x, Index y) {
     sort_protection();
-    return std::binary_search(protected_edges_.begin(), protected_edges_.end(), key2(x, y));
+    return std::binary_search(protected_edges_.begin(), protected_edges_.end(), edge_key(x, y));
   }
   bool face_protected(Index x, Index y, Index z) {
     sort_protection();
@@ -505,11 +501,14 @@ class SeedFlips {
     if (ring.size() < 3 || static_cast<int>(ring.size()) > kMaxRing) return false;
     // It depends only on the tets at c, d and the ring's vertices: a failure is remembered with
     // their change counters (which only grow), and not tried again while their sum is unchanged.
-    std::uint64_t signature = changes_[c] + changes_[d];
-    for (Index p : ring) signature += changes_[p];
-    const std::uint64_t key = key2(c, d);
+    auto signature = [&] {
+      std::uint64_t sum = changes_[c] + changes_[d];
+      for (Index p : ring) sum += changes_[p];
+      return sum;
+    };
+    const std::uint64_t key = edge_key(c, d);
     if (const auto it = failed_deep_.find(key);
-        it != failed_deep_.end() && it->second == std::pair{level, signature})
+        it != failed_deep_.end() && it->second == std::pair{level, signature()})
       return false;
     const bool was_logging = logging_;
     logging_ = true;
@@ -525,12 +524,7 @@ class SeedFlips {
       }
     logging_ = was_logging;
     if (!logging_) log_.clear();
-    if (!done) {
-      // The undone flips counted as changes: the signature after them.
-      std::uint64_t after = changes_[c] + changes_[d];
-      for (Index p : ring) after += changes_[p];
-      failed_deep_[key] = {level, after};
-    }
+    if (!done) failed_deep_[key] = {level, signature()};  // after the undos (they count as changes)
     return done;
   }
   /// The tet t2 across the face (c, d, e) of tet t opposite vertex ia, and its vertex f off that
@@ -863,13 +857,16 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     SeedFlips flips(tets, corner0_ + 8, point_of);
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
       flips.protect_triangle(triangle_vertex(tr, 0), triangle_vertex(tr, 1), triangle_vertex(tr, 2));
-    std::vector<std::pair<Index, Index>> missing;
+    auto recover = [&](Index a, Index b) {
+      return flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge);
+    };
+    std::vector<std::pair<Index, Index>> missing;  // edges not recovered yet, for two more passes
     for (Index tr = 0; tr < surface_.num_triangles(); ++tr)
       for (int k = 0; k < 3; ++k) {
         const Index a = triangle_vertex(tr, k), b = triangle_vertex(tr, (k + 1) % 3);
         if (a > b || flips.has_edge(a, b)) continue;  // each edge once (its other triangle has it reversed)
         ++stats_.seed_missing_edges;
-        if (flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge))
+        if (recover(a, b))
           ++stats_.seed_recovered_edges;
         else
           missing.push_back({a, b});
@@ -877,7 +874,7 @@ void BspComplex::seed_delaunay(std::int64_t max_conflicts) {
     for (int pass = 0; pass < 2 && !missing.empty(); ++pass) {
       std::vector<std::pair<Index, Index>> still;
       for (const auto& [a, b] : missing)
-        if (flips.recover_edge(a, b, kMaxFlipsPerEdge) || flips.recover_edge(b, a, kMaxFlipsPerEdge))
+        if (recover(a, b))
           ++stats_.seed_recovered_edges;
         else
           still.push_back({a, b});

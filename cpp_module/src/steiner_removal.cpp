@@ -128,6 +128,18 @@ double best_direction(const std::vector<Vec3>& ms, Vec3* best) {
   return chebyshev_centre(hs, 1.0, best);
 }
 
+// A hash of a vertex triple (faces keyed by their vertices).
+inline std::size_t triple_hash(const std::array<Index, 3>& f) {
+  std::uint64_t h = static_cast<std::uint32_t>(f[0]);
+  h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[1]);
+  h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[2]);
+  return static_cast<std::size_t>(h ^ (h >> 29));
+}
+// The four faces of tet t, each oriented with t on its negative side (outward, for a positive t).
+inline std::array<std::array<Index, 3>, 4> outward_faces(const std::array<Index, 4>& t) {
+  return {{{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+}
+
 // Exact orient3d(f[0], f[2], f[1], apex) for one apex and many faces f, remembered per face (a
 // hash map: a tree map's lookups cost more than the predicates they saved) when `remember`: a
 // cavity that grows keeps most of its boundary faces, which need not be decided again.
@@ -148,12 +160,7 @@ class SeesFace {
     return geo_.orient3d(f[0], f[2], f[1], apex_) == Sign::kPositive;
   }
   struct Hash {
-    std::size_t operator()(const std::array<Index, 3>& f) const {
-      std::uint64_t h = static_cast<std::uint32_t>(f[0]);
-      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[1]);
-      h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(f[2]);
-      return static_cast<std::size_t>(h ^ (h >> 29));
-    }
+    std::size_t operator()(const std::array<Index, 3>& f) const { return triple_hash(f); }
   };
   ImplicitGeometry& geo_;
   Index apex_;
@@ -186,7 +193,7 @@ class CavityBoundary {
     std::sort(key.begin(), key.end());
     if (2 * (used_ + 1) > slots_.size()) rehash();
     const std::size_t mask = slots_.size() - 1;
-    std::size_t i = hash(key) & mask, tomb = kNone;
+    std::size_t i = triple_hash(key) & mask, tomb = kNone;
     for (;; i = (i + 1) & mask) {
       const std::int32_t s = slots_[i];
       if (s == kEmpty) break;
@@ -213,19 +220,13 @@ class CavityBoundary {
  private:
   static constexpr std::int32_t kEmpty = -1, kTomb = -2;
   static constexpr std::size_t kNone = ~std::size_t{0};
-  static std::size_t hash(const std::array<Index, 3>& k) {
-    std::uint64_t h = static_cast<std::uint32_t>(k[0]);
-    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(k[1]);
-    h = h * 0x9E3779B97F4A7C15ull + static_cast<std::uint32_t>(k[2]);
-    return static_cast<std::size_t>(h ^ (h >> 29));
-  }
   void rehash() {
     std::size_t cap = 16;
     while (cap < 4 * (live_ + 1)) cap *= 2;
     slots_.assign(cap, kEmpty);
     for (std::size_t n = 0; n < faces_.size(); ++n) {
       if (!faces_[n].alive) continue;
-      std::size_t i = hash(faces_[n].key) & (cap - 1);
+      std::size_t i = triple_hash(faces_[n].key) & (cap - 1);
       while (slots_[i] != kEmpty) i = (i + 1) & (cap - 1);
       slots_[i] = static_cast<std::int32_t>(n);
     }
@@ -660,11 +661,11 @@ class TetComplex {
       // Double pre-checks are not exact; everything is decided on the new vertex below.
       const Index wid = geo_.add_explicit_point(w);
       // Cone from w; a face w does not see is removed from the cavity's boundary by taking the tet
-      // beyond it into the cavity (never across the surface), a few times at most.
-      // The cavity's tets are stamped (start_cavity); its boundary is a CavityBoundary. Whether w
-      // sees a boundary face is decided once, when the face joins the boundary, in the order of
-      // the sorted triples: a face w does not see has its tet beyond taken at once, so the faces
-      // that stay are the ones w sees. The new surface faces' answers are kept (seen_new).
+      // beyond it into the cavity (never across the surface), a few times at most. The cavity's
+      // tets are stamped (start_cavity); its boundary is a CavityBoundary. Whether w sees a
+      // boundary face is decided once, when the face joins the boundary, in the order of the
+      // sorted triples: a face w does not see has its tet beyond taken at once, so the faces that
+      // stay are the ones w sees. The new surface faces' answers are kept (seen_new).
       std::vector<Index> cav = cavity;
       start_cavity(cav);
       bnd_.clear();
@@ -729,11 +730,7 @@ class TetComplex {
         add.erase(std::unique(add.begin(), add.end()), add.end());
         for (Index id : add) {
           cav_stamp_[static_cast<std::size_t>(id)] = stamp_;
-          const auto& t = tets_[id];
-          for (const std::array<Index, 3>& g :
-               {std::array<Index, 3>{t[0], t[2], t[1]}, std::array<Index, 3>{t[0], t[1], t[3]},
-                std::array<Index, 3>{t[0], t[3], t[2]}, std::array<Index, 3>{t[1], t[2], t[3]}})
-            bnd_.toggle(g);
+          for (const auto& g : outward_faces(tets_[id])) bnd_.toggle(g);
         }
         cav.insert(cav.end(), add.begin(), add.end());
         work += static_cast<std::int64_t>(bnd_.size() + cav.size());  // the growth's own cost
@@ -884,8 +881,7 @@ class TetComplex {
       for (Index p : cs) {
         const std::array<Index, 4> t{f[0], f[2], f[1], p};
         // Fill t: the front loses t's faces that are on it and gains the reverse of the others.
-        const std::array<std::array<Index, 3>, 4> tf = {
-            {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
+        const std::array<std::array<Index, 3>, 4> tf = outward_faces(t);
         std::array<std::pair<bool, std::array<Index, 3>>, 4> undo;  // (removed?, face)
         int undone = 0;
         bool fits = true;
@@ -1079,10 +1075,7 @@ class TetComplex {
     std::vector<FacePair> all;
     all.reserve(4 * ids.size());
     for (Index id : ids) {
-      const auto& t = tets_[id];
-      const std::array<std::array<Index, 3>, 4> fs = {
-          {{t[0], t[2], t[1]}, {t[0], t[1], t[3]}, {t[0], t[3], t[2]}, {t[1], t[2], t[3]}}};
-      for (const auto& f : fs) {
+      for (const auto& f : outward_faces(tets_[id])) {
         std::array<Index, 3> key = f;
         std::sort(key.begin(), key.end());
         all.push_back({key, f});
