@@ -121,9 +121,14 @@ def add_gmsh_mesh(case, max_size, order):
     obj.CharacteristicLengthMax = max_size
     obj.ElementOrder = "2nd" if order == 2 else "1st"
     case.doc.recompute()
-    error = GmshTools(obj).create_mesh()
-    if error:
-        raise InternalError("Gmsh failed: %s" % error)
+    # FreeCAD's GmshTools returns Gmsh's whole stderr, warnings included. Gmsh 4.8 sometimes
+    # (not on every run of the same input: seen once in CI on the plate with a hole) ends with
+    # "Warning : 1 ill-shaped tets are still in the mesh" and "0 errors": a mesh, usable. Only
+    # an error line or an empty mesh is a failure.
+    output = GmshTools(obj).create_mesh()
+    errors = [line for line in (output or "").splitlines() if line.lstrip().startswith("Error")]
+    if errors or obj.FemMesh.VolumeCount == 0:
+        raise InternalError("Gmsh failed: %s" % (output or "no volume elements"))
     case.analysis.addObject(obj)
     case.mesh = obj
     return obj
