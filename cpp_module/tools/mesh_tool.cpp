@@ -16,6 +16,12 @@
 // --no-check: skip the exact check of the output (timing the core alone, as a benchmark beside
 //   TetGen does; the benchmark then checks the written mesh itself). Prints UNCHECKED, exit 0.
 //
+// --pieces N / --max-piece-triangles K / --max-memory SIZE (e.g. 2G, 512M): the out-of-core mode
+//   (out_of_core.h): the solid is cut into pieces of at most ceil(#T / N), K, or as many triangles
+//   as SIZE allows by the program's estimate, meshed one after the other and streamed to --write
+//   STEM (needed). Without --no-check each piece's mesh is checked exactly against its own surface
+//   (which checks the whole mesh in one piece's memory) instead of the whole mesh at the end.
+//
 // The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
 // shells facing the wrong way); --reorient flips triangles as that check allows.
 //
@@ -23,6 +29,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cctype>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -30,15 +38,30 @@
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesh_io.h"
 #include "bsptet/mesher.h"
+#include "bsptet/out_of_core.h"
 #include "bsptet/surface_check.h"
 
 using namespace bsptet;
+
+// "2G", "512M", "1.5GiB", "1000000" -> bytes (binary units); -1 when it is not a size.
+static long long parse_size(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  std::string unit(end);
+  for (char& c : unit) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  double scale = 0;
+  if (unit.empty() || unit == "b") scale = 1;
+  else if (unit == "k" || unit == "kb" || unit == "kib") scale = 1024.0;
+  else if (unit == "m" || unit == "mb" || unit == "mib") scale = 1024.0 * 1024;
+  else if (unit == "g" || unit == "gb" || unit == "gib") scale = 1024.0 * 1024 * 1024;
+  return end == text.c_str() || scale == 0 || !(v * scale >= 1) ? -1 : static_cast<long long>(v * scale);
+}
 
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--seed auto|delaunay|box] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
-                 "[--progress] [--no-check] [--write STEM]\n",
+                 "[--progress] [--no-check] [--write STEM] [--pieces N | --max-piece-triangles K | --max-memory SIZE]\n",
                  argv[0]);
     return 2;
   }
@@ -46,6 +69,7 @@ int main(int argc, char** argv) {
   SurfaceCheckOptions check;
   std::string stem;
   bool no_check = false;
+  long long pieces = 0, piece_triangles = 0, max_memory = 0;  // the out-of-core mode when any is set
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
@@ -86,6 +110,15 @@ int main(int argc, char** argv) {
         last_pct = pct;
       };
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
+    else if (!std::strcmp(argv[i], "--pieces") && i + 1 < argc) pieces = std::strtoll(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--max-piece-triangles") && i + 1 < argc) piece_triangles = std::strtoll(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--max-memory") && i + 1 < argc) {
+      max_memory = parse_size(argv[++i]);
+      if (max_memory < 0) {
+        std::fprintf(stderr, "--max-memory: cannot read %s as a size (write e.g. 2G or 512M)\n", argv[i]);
+        return 2;
+      }
+    }
     else {
       std::fprintf(stderr, "unknown argument %s\n", argv[i]);
       return 2;
@@ -99,6 +132,33 @@ int main(int argc, char** argv) {
     const double read_s = since(t0);
     // The surface check's self-intersection search runs beside the core (check_and_tetrahedralize);
     // "check beyond the core" below: the rest of the check, done first, and any wait for the search.
+    if (pieces > 0 || piece_triangles > 0 || max_memory > 0) {
+      if (stem.empty()) {
+        std::fprintf(stderr, "--pieces, --max-piece-triangles and --max-memory write the mesh as they go: give --write STEM\n");
+        return 2;
+      }
+      t0 = Clock::now();
+      s.tri = check_surface(s, check).tri;
+      const double check_s = since(t0);
+      PieceOptions po;
+      po.check_pieces = !no_check;
+      po.max_piece_triangles = piece_triangles > 0 ? piece_triangles
+                               : pieces > 0       ? (s.num_triangles() + pieces - 1) / pieces
+                                                  : piece_triangles_for_budget(max_memory);
+      if (o.progress) po.log = [](const std::string& line) { std::fprintf(stderr, "[%s]\n", line.c_str()); };
+      PieceStats ps;
+      tetrahedralize_in_pieces(s, o, po, stem, &ps);
+      std::printf("%s: %s tets %lld points %lld steiner %lld pieces %lld (largest %lld triangles, at most %lld) cuts %lld "
+                  "(refused %lld) cap_triangles %lld\n  program: read %.3f s  check %.3f s  cutting %.3f s  meshing "
+                  "%.3f s  writing %.3f s\n",
+                  argv[1], no_check ? "UNCHECKED" : "VALID (each piece checked exactly)", static_cast<long long>(ps.tets),
+                  static_cast<long long>(ps.points), static_cast<long long>(ps.steiner_points),
+                  static_cast<long long>(ps.pieces), static_cast<long long>(ps.largest_piece_triangles),
+                  static_cast<long long>(po.max_piece_triangles), static_cast<long long>(ps.cuts),
+                  static_cast<long long>(ps.cuts_refused), static_cast<long long>(ps.cap_triangles), read_s, check_s,
+                  ps.seconds_cutting, ps.seconds_meshing, ps.seconds_writing);
+      return 0;
+    }
     MeshStats st;
     t0 = Clock::now();
     SurfaceCheckResult checked;
