@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "bsptet/errors.h"
 #include "bsptet/mesh_check.h"
+#include "bsptet/self_intersection.h"
 #include "bsptet/solid_cut.h"
 #include "bsptet/surface_check.h"
 
@@ -21,16 +23,18 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 constexpr std::int64_t kBaseBytes = 32LL << 20;
 constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
 constexpr int kRepairRounds = 8;
+constexpr std::size_t kMaxCandidates = 27;
+constexpr std::int64_t kMaxRepairPairs = 100000;
 
 // A piece's own surface: the input vertices its triangles use (ascending input ids, returned in
 // `globals`) and its triangles over them.
-SurfaceMesh local_surface(const SurfaceMesh& input, const std::vector<Index>& tri, std::vector<Index>& globals) {
+SurfaceMesh local_surface(const std::vector<double>& points, const std::vector<Index>& tri, std::vector<Index>& globals) {
   globals.assign(tri.begin(), tri.end());
   std::sort(globals.begin(), globals.end());
   globals.erase(std::unique(globals.begin(), globals.end()), globals.end());
   SurfaceMesh s;
   s.xyz.reserve(3 * globals.size());
-  for (Index g : globals) s.xyz.insert(s.xyz.end(), &input.xyz[3 * static_cast<std::size_t>(g)], &input.xyz[3 * static_cast<std::size_t>(g) + 3]);
+  for (Index g : globals) s.xyz.insert(s.xyz.end(), &points[3 * static_cast<std::size_t>(g)], &points[3 * static_cast<std::size_t>(g) + 3]);
   s.tri.resize(tri.size());
   for (std::size_t i = 0; i < tri.size(); ++i)
     s.tri[i] = static_cast<Index>(std::lower_bound(globals.begin(), globals.end(), tri[i]) - globals.begin());
@@ -39,12 +43,12 @@ SurfaceMesh local_surface(const SurfaceMesh& input, const std::vector<Index>& tr
 
 // Empty when check_surface accepts the piece as it is, else its message; `pairs` receives the
 // intersecting triangle pairs (piece triangle indices) when that is the problem.
-std::string surface_problem(const SurfaceMesh& input, const std::vector<Index>& tri,
+std::string surface_problem(const std::vector<double>& points, const std::vector<Index>& tri,
                             std::vector<std::array<Index, 2>>& pairs) {
   std::vector<Index> globals;
   pairs.clear();
   try {
-    check_surface(local_surface(input, tri, globals));
+    check_surface(local_surface(points, tri, globals));
   } catch (const SelfIntersectionError& e) {
     pairs = e.pairs();
     return e.what();
@@ -54,73 +58,135 @@ std::string surface_problem(const SurfaceMesh& input, const std::vector<Index>& 
   return {};
 }
 
+// The surface triangles of a piece (source >= 0) that a cap triangle of it (source < 0) crosses,
+// by the exact search of self_intersection.h on the caps and the triangles whose boxes meet the
+// caps' box. Only to steer the repairs: the piece is then checked whole.
+std::vector<Index> cap_crossings(const std::vector<double>& points, const std::vector<Index>& piece,
+                                 const std::vector<Index>& source) {
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t t = 0; t < source.size(); ++t)
+    if (source[t] < 0)
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) {
+          const double x = points[3 * static_cast<std::size_t>(piece[3 * t + k]) + a];
+          lo[a] = std::min(lo[a], x), hi[a] = std::max(hi[a], x);
+        }
+  SurfaceMesh near;
+  near.xyz = points;
+  std::vector<Index> from;  // near's triangle -> piece triangle
+  for (std::size_t t = 0; t < source.size(); ++t) {
+    bool meets = true;
+    for (int a = 0; a < 3 && meets; ++a) {
+      double l = HUGE_VAL, h = -HUGE_VAL;
+      for (int k = 0; k < 3; ++k) {
+        const double x = points[3 * static_cast<std::size_t>(piece[3 * t + k]) + a];
+        l = std::min(l, x), h = std::max(h, x);
+      }
+      meets = l <= hi[a] && h >= lo[a];
+    }
+    if (!meets) continue;
+    near.tri.insert(near.tri.end(), &piece[3 * t], &piece[3 * t + 3]);
+    from.push_back(static_cast<Index>(t));
+  }
+  std::vector<Index> crossed;
+  for (const auto& pair : find_self_intersections(near, kMaxRepairPairs)) {
+    const Index a = source[from[pair[0]]], b = source[from[pair[1]]];
+    if ((a < 0) != (b < 0)) crossed.push_back(a < 0 ? b : a);
+  }
+  return crossed;
+}
+
 // Cuts the piece `tri` in two (below, above) by the first cut that solid_cut makes and that
-// check_surface accepts on both sides: across the axes by decreasing extent, at the quantiles
-// 0.5, 0.4, 0.6, 0.3, 0.7 of the triangles' corner sums. Where a cap crosses a surface triangle,
-// the triangles around that triangle's vertices are moved to the other side and the cut made
-// again (at most kRepairRounds times). False when no cut works.
-bool cut_piece(const SurfaceMesh& input, const std::vector<Index>& tri, std::vector<Index>& below,
+// check_surface accepts on both sides (candidates below). Where a cap crosses a surface
+// triangle, the triangles around that triangle's vertices are moved to the other side and the
+// cut made again (at most kRepairRounds times). False when no cut works.
+bool cut_piece(std::vector<double>& points, const std::vector<Index>& tri, std::vector<Index>& below,
                std::vector<Index>& above, PieceStats& st, const std::function<void(const std::string&)>& log) {
   const std::size_t n = tri.size() / 3;
-  double lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = input.xyz[3 * static_cast<std::size_t>(tri[0]) + a];
-  for (Index v : tri)
-    for (int a = 0; a < 3; ++a) {
-      const double x = input.xyz[3 * static_cast<std::size_t>(v) + a];
-      lo[a] = std::min(lo[a], x), hi[a] = std::max(hi[a], x);
+  // Candidate cuts: across each axis at the quantiles 0.3, 0.35, ..., 0.7 of the triangles'
+  // corner sums, tried in order of how many edges join the two sides before smoothing (a plane
+  // that grazes the surface, or crosses long thin triangles, gives long zigzag loops whose caps
+  // cross the surface).
+  const std::vector<Index> across = edge_neighbours(tri);
+  struct Candidate {
+    std::int64_t loop_edges;
+    int axis;
+    double threshold;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> sums(n), sorted(n);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::size_t t = 0; t < n; ++t) sums[t] = corner_sum(points, &tri[3 * t], axis);
+    sorted = sums;
+    std::sort(sorted.begin(), sorted.end());
+    for (int q = 6; q <= 14; ++q) {
+      const double threshold = sorted[std::min(n - 1, std::max<std::size_t>(1, n * static_cast<std::size_t>(q) / 20))];
+      if (threshold == sorted[0]) continue;
+      bool seen = false;
+      for (const auto& c : candidates) seen = seen || (c.axis == axis && c.threshold == threshold);
+      if (seen) continue;
+      std::int64_t count = 0;
+      for (std::size_t i = 0; i < across.size(); ++i)
+        count += across[i] >= 0 && (sums[i / 3] < threshold) != (sums[static_cast<std::size_t>(across[i])] < threshold);
+      candidates.push_back({count / 2, axis, threshold});
     }
-  std::array<int, 3> axes{0, 1, 2};
-  std::stable_sort(axes.begin(), axes.end(), [&](int a, int b) { return hi[a] - lo[a] > hi[b] - lo[b]; });
-  std::vector<double> sums(n);
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.loop_edges < b.loop_edges; });
+  if (candidates.size() > kMaxCandidates) candidates.resize(kMaxCandidates);
   std::vector<std::array<Index, 2>> pairs;
-  for (int axis : axes) {
-    for (std::size_t t = 0; t < n; ++t) sums[t] = corner_sum(input.xyz, &tri[3 * t], axis);
-    std::sort(sums.begin(), sums.end());
-    std::vector<double> tried;
-    for (double q : {0.5, 0.4, 0.6, 0.3, 0.7}) {
-      const double threshold = sums[std::min(n - 1, std::max<std::size_t>(1, static_cast<std::size_t>(q * n)))];
-      if (threshold == sums[0] || std::find(tried.begin(), tried.end(), threshold) != tried.end()) continue;
-      tried.push_back(threshold);
-      const std::string where = "cut of a piece of " + std::to_string(n) + " triangles across " + "xyz"[axis] +
-                                " at corner sum " + std::to_string(threshold);
-      std::vector<std::pair<Index, char>> forced;
-      std::string why;
-      for (int round = 0; round <= kRepairRounds; ++round) {
-        SolidCut cut = cut_solid(input.xyz, tri, axis, threshold, forced);
-        if (!cut.ok) {
-          why = cut.reason;
-          break;
-        }
-        const std::size_t forced_before = forced.size();
-        for (int side = 1; side >= 0 && why.empty(); --side) {
-          const std::vector<Index>& piece = side ? cut.below : cut.above;
-          const std::vector<Index>& source = side ? cut.below_source : cut.above_source;
-          why = surface_problem(input, piece, pairs);
-          for (const auto& pair : pairs) {
-            const Index a = source[pair[0]], b = source[pair[1]];
-            if ((a < 0) == (b < 0)) continue;  // only a cap crossing a surface triangle is repaired
-            const Index t = a < 0 ? b : a;
-            for (int k = 0; k < 3; ++k) forced.emplace_back(tri[3 * static_cast<std::size_t>(t) + k], static_cast<char>(!side));
-          }
-        }
-        if (why.empty()) {
-          ++st.cuts;
-          st.cap_triangles += cut.cap_triangles;
-          if (log)
-            log(where + ": " + std::to_string(cut.below.size() / 3) + " + " + std::to_string(cut.above.size() / 3) +
-                " triangles, " + std::to_string(cut.loops) + " loops, " + std::to_string(cut.cap_triangles) +
-                " cap triangles" + (round ? ", after " + std::to_string(round) + " repairs" : std::string()));
-          below = std::move(cut.below);
-          above = std::move(cut.above);
-          return true;
-        }
-        if (forced.size() == forced_before) break;
-        if (round < kRepairRounds) why.clear();
+  for (const Candidate& candidate : candidates) {
+    const int axis = candidate.axis;
+    const double threshold = candidate.threshold;
+    const std::string where = "cut of a piece of " + std::to_string(n) + " triangles across " + "xyz"[axis] +
+                              " at corner sum " + std::to_string(threshold);
+    std::vector<std::pair<Index, char>> forced;
+    std::string why;
+    for (int round = 0; round <= kRepairRounds && why.empty(); ++round) {
+      SolidCut cut = cut_solid(points, tri, axis, threshold, forced);
+      if (!cut.ok) {
+        why = cut.reason;
+        break;
       }
-      ++st.cuts_refused;
-      st.refused.push_back(where + ": " + why);
-      if (log) log(where + " refused: " + why);
+      const std::size_t old_size = points.size();
+      points.insert(points.end(), cut.new_points.begin(), cut.new_points.end());  // dropped if refused
+      // Repair where a cap crosses a surface triangle (found near the caps only), then check both
+      // pieces whole.
+      std::size_t crossings = 0;
+      for (int side = 1; side >= 0; --side) {
+        const std::vector<Index>& source = side ? cut.below_source : cut.above_source;
+        for (Index t : cap_crossings(points, side ? cut.below : cut.above, source)) {
+          ++crossings;
+          for (int k = 0; k < 3; ++k) forced.emplace_back(tri[3 * static_cast<std::size_t>(t) + k], static_cast<char>(!side));
+        }
+      }
+      if (crossings > 0) {
+        points.resize(old_size);
+        if (round == kRepairRounds) why = std::to_string(crossings) + " surface triangles still cross its caps after " +
+                                          std::to_string(kRepairRounds) + " repairs";
+        continue;
+      }
+      why = surface_problem(points, cut.below, pairs);
+      if (why.empty()) why = surface_problem(points, cut.above, pairs);
+      if (!why.empty()) {
+        points.resize(old_size);
+        break;
+      }
+      ++st.cuts;
+      st.cap_triangles += cut.cap_triangles;
+      st.cap_points += cut.cap_points;
+      if (log)
+        log(where + ": " + std::to_string(cut.below.size() / 3) + " + " + std::to_string(cut.above.size() / 3) +
+            " triangles, " + std::to_string(cut.loops) + " loops, " + std::to_string(cut.cap_triangles) +
+            " cap triangles, " + std::to_string(cut.cap_points) + " cap points" +
+            (round ? ", after " + std::to_string(round) + " repairs" : std::string()));
+      below = std::move(cut.below);
+      above = std::move(cut.above);
+      return true;
     }
+    ++st.cuts_refused;
+    st.refused.push_back(where + ": " + why);
+    if (log) log(where + " refused: " + why);
   }
   return false;
 }
@@ -175,25 +241,28 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
   // 1. Cut until every piece is small enough (depth first, below before above: deterministic).
   auto t0 = Clock::now();
   std::vector<std::vector<Index>> todo{surface.tri}, pieces;
+  std::vector<double> points = surface.xyz;  // the input's, then the caps' own
   while (!todo.empty()) {
     std::vector<Index> tri = std::move(todo.back());
     todo.pop_back();
     const std::int64_t n = static_cast<std::int64_t>(tri.size() / 3);
-    if (po.max_piece_triangles <= 0 || n <= po.max_piece_triangles) {
+    if (po.max_piece_triangles <= 0 || n <= po.max_piece_triangles || n <= po.min_piece_triangles) {
       pieces.push_back(std::move(tri));
       continue;
     }
     check_cancel();
     if (options.progress) options.progress("cutting into pieces", 0);
     std::vector<Index> below, above;
-    if (!cut_piece(surface, tri, below, above, st, po.log)) {
+    const std::size_t refused_before = st.refused.size();
+    if (!cut_piece(points, tri, below, above, st, po.log)) {
       std::string reasons;
-      for (std::size_t i = st.refused.size() >= 3 ? st.refused.size() - 3 : 0; i < st.refused.size(); ++i)
+      for (std::size_t i = std::max(refused_before, st.refused.size() >= 3 ? st.refused.size() - 3 : 0); i < st.refused.size(); ++i)
         reasons += "\n  " + st.refused[i];
-      throw InputError(ErrorCode::kBadArgument, "pieces", static_cast<std::int64_t>(pieces.size()),
-                       "the out-of-core mode could not cut a piece of " + std::to_string(n) +
-                           " triangles into two (every cut tried was refused; the last ones:" + reasons +
-                           "\n); nothing was written. Raise the memory budget (larger pieces) or mesh in one piece");
+      st.uncut.push_back("a piece of " + std::to_string(n) + " triangles could not be cut (every cut tried was refused; the last ones:" +
+                         reasons + "\n): it is meshed whole");
+      if (po.log) po.log(st.uncut.back());
+      pieces.push_back(std::move(tri));
+      continue;
     }
     todo.push_back(std::move(above));
     todo.push_back(std::move(below));
@@ -202,9 +271,11 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
   for (const auto& p : pieces) st.largest_piece_triangles = std::max<std::int64_t>(st.largest_piece_triangles, p.size() / 3);
   st.seconds_cutting = since(t0);
 
-  // 2. Output numbering: the used input points in input order, then the Steiner points.
-  std::vector<Index> out_id(surface.num_points(), -1);
+  // 2. Output numbering: the used input points in input order, the caps' points, then the
+  // pieces' Steiner points.
+  std::vector<Index> out_id(points.size() / 3, -1);
   for (Index v : surface.tri) out_id[v] = 0;
+  for (std::size_t v = surface.xyz.size() / 3; v < out_id.size(); ++v) out_id[v] = 0;
   Index used = 0;
   for (Index& id : out_id)
     if (id == 0) id = used++;
@@ -219,7 +290,7 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
   for (std::size_t p = 0; p < pieces.size(); ++p) {
     check_cancel();
     std::vector<Index> globals;
-    const SurfaceMesh local = local_surface(surface, pieces[p], globals);
+    const SurfaceMesh local = local_surface(points, pieces[p], globals);
     pieces[p] = {};
     const std::string name = "piece " + std::to_string(p + 1) + "/" + std::to_string(pieces.size());
     MeshOptions o = options;
@@ -270,10 +341,9 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
     File node = open_file(stem + ".node.part", "w");
     std::fprintf(node.get(), "%lld 3 0 0\n", static_cast<long long>(st.points));
     long long line = 0;
-    for (Index g = 0; g < surface.num_points(); ++g)
+    for (std::size_t g = 0; g < out_id.size(); ++g)
       if (out_id[g] >= 0)
-        std::fprintf(node.get(), "%lld %.17g %.17g %.17g\n", ++line, surface.xyz[3 * static_cast<std::size_t>(g)],
-                     surface.xyz[3 * static_cast<std::size_t>(g) + 1], surface.xyz[3 * static_cast<std::size_t>(g) + 2]);
+        std::fprintf(node.get(), "%lld %.17g %.17g %.17g\n", ++line, points[3 * g], points[3 * g + 1], points[3 * g + 2]);
     File in = File(std::fopen(steiner_path.c_str(), "rb"));
     std::vector<double> buf(3 * 4096);
     for (std::size_t got; in && (got = std::fread(buf.data(), sizeof(double), buf.size(), in.get())) > 0;)

@@ -148,14 +148,16 @@ int main(int argc, char** argv) {
       if (o.progress) po.log = [](const std::string& line) { std::fprintf(stderr, "[%s]\n", line.c_str()); };
       PieceStats ps;
       tetrahedralize_in_pieces(s, o, po, stem, &ps);
+      for (const auto& line : ps.uncut) std::fprintf(stderr, "warning: %s\n", line.c_str());
       std::printf("%s: %s tets %lld points %lld steiner %lld pieces %lld (largest %lld triangles, at most %lld) cuts %lld "
-                  "(refused %lld) cap_triangles %lld\n  program: read %.3f s  check %.3f s  cutting %.3f s  meshing "
+                  "(refused %lld) cap_triangles %lld cap_points %lld\n  program: read %.3f s  check %.3f s  cutting %.3f s  meshing "
                   "%.3f s  writing %.3f s\n",
                   argv[1], no_check ? "UNCHECKED" : "VALID (each piece checked exactly)", static_cast<long long>(ps.tets),
                   static_cast<long long>(ps.points), static_cast<long long>(ps.steiner_points),
                   static_cast<long long>(ps.pieces), static_cast<long long>(ps.largest_piece_triangles),
                   static_cast<long long>(po.max_piece_triangles), static_cast<long long>(ps.cuts),
-                  static_cast<long long>(ps.cuts_refused), static_cast<long long>(ps.cap_triangles), read_s, check_s,
+                  static_cast<long long>(ps.cuts_refused), static_cast<long long>(ps.cap_triangles),
+                  static_cast<long long>(ps.cap_points), read_s, check_s,
                   ps.seconds_cutting, ps.seconds_meshing, ps.seconds_writing);
       return 0;
     }

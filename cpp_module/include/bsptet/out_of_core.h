@@ -14,8 +14,9 @@
 //  * Cuts (solid_cut.h): a piece with more than max_piece_triangles triangles is cut across its
 //    longest extent, at the median of its triangles' corner sums, else at other quantiles and
 //    across the other axes, until both halves pass check_surface exactly (caps that cross the
-//    surface, folded or holed cross-sections are refused there). A piece no tried cut splits
-//    throws InputError (kBadArgument, stage "pieces") naming it and the reasons: nothing written.
+//    surface, folded or holed cross-sections are refused there). A piece of at most
+//    min_piece_triangles is never cut. A piece that no tried cut splits is meshed whole, and
+//    PieceStats::uncut says so (its run may then need more memory than the budget meant).
 //  * The caps are made of input vertices and every piece is meshed with no Steiner point on its
 //    boundary (MeshOptions::allow_boundary_steiner must be false), so two pieces meet in exactly
 //    their caps' triangles: the union of the pieces' meshes is a conforming mesh of the solid
@@ -24,7 +25,8 @@
 //    before it is spooled; with the cut argument above that checks the whole mesh, in the
 //    memory of one piece. A piece that fails throws MeshingError: nothing written.
 //  * Output: stem.node (the used input points first, in input order, renumbered as
-//    tetrahedralize does, then each piece's Steiner points in piece order) and stem.ele (each
+//    tetrahedralize does, then the caps' own points, which are inside the solid, then each
+//    piece's Steiner points in piece order) and stem.ele (each
 //    piece's tets in piece order), 1-based, as write_tetgen (mesh_io.h). Both are written to
 //    temporary names beside them and renamed when complete; the spool files beside them are
 //    removed whatever happens. Deterministic.
@@ -44,6 +46,9 @@ namespace bsptet {
 struct PieceOptions {
   /// A piece with more triangles (its caps included) is cut; 0: no cut (one piece).
   std::int64_t max_piece_triangles = 0;
+  /// A piece with at most this many triangles is never cut (cutting small pieces saves no memory
+  /// worth having, and their coarse caps are more often refused).
+  std::int64_t min_piece_triangles = 1000;
   /// Check each piece's mesh exactly before spooling it (see the contract).
   bool check_pieces = true;
   /// Called with one line per cut and per piece meshed (may be empty).
@@ -51,12 +56,13 @@ struct PieceOptions {
 };
 
 struct PieceStats {
-  std::int64_t pieces = 0, cuts = 0, cuts_refused = 0, cap_triangles = 0;
+  std::int64_t pieces = 0, cuts = 0, cuts_refused = 0, cap_triangles = 0, cap_points = 0;
   std::int64_t largest_piece_triangles = 0;
   std::int64_t points = 0, tets = 0, steiner_points = 0;
   bool pieces_checked = false;  ///< every piece's mesh was checked exactly (and was valid)
   double seconds_cutting = 0, seconds_meshing = 0, seconds_writing = 0;
   std::vector<std::string> refused;  ///< why refused cuts were refused, one line each
+  std::vector<std::string> uncut;    ///< pieces over max_piece_triangles meshed whole, and why
 };
 
 /// Estimated peak bytes of one tetrahedralize run on `triangles` triangles (the program's own

@@ -17,18 +17,23 @@
 //    above triangle, directed as in their below triangle, must then form disjoint simple loops
 //    (a vertex on two of them, or twice on one, refuses the cut).
 //  * Each loop is closed by a CAP: the loop, reversed, projected along `axis`
-//    (orient2d_projected's convention, predicates.h), triangulated without new vertices by exact
-//    ear clipping, then made Delaunay in the projection by Lawson flips where the in-circle
-//    filter is certain (only for shape: any triangulation is as valid); the cap's triangles keep
-//    the loop's own 3D vertices. A loop whose reversed projection does not turn counter-clockwise
-//    (a hole of the cross-section, a fold) or that no ear clipping finishes refuses the cut.
+//    (orient2d_projected's convention, predicates.h), triangulated by exact ear clipping, made
+//    Delaunay in the projection by Lawson flips where the in-circle filter is certain, then given
+//    points of its own: a grid of spacing twice the loop's mean projected edge (cells along the
+//    loop left empty), each inserted where it falls strictly inside a triangle (Delaunay
+//    insertion in the projection; polygon edges are never flipped), placed at `threshold` / 3
+//    along `axis`. The loop's triangles keep the loop's own 3D vertices. A loop whose reversed
+//    projection does not turn counter-clockwise (a hole of the cross-section, a fold) or that no
+//    ear clipping finishes refuses the cut. The flips and the points are for shape only: any
+//    triangulation is as valid, and the caller checks the result.
 //  * cut.below = the below triangles and the caps; cut.above = the above triangles and the caps
 //    reversed. As 2-chains below + above = the input, so where both are valid closed surfaces
 //    (check_surface, surface_check.h) their solids are the input's solid split along the caps:
 //    disjoint interiors, common boundary the caps. NOTHING HERE IS TRUSTED: a cap may cross the
 //    surface where it is nearly parallel to the cut, or its lifted triangles may meet; the caller
 //    checks both pieces exactly and drops the cut when either fails.
-//  * No new point, no rounding: every vertex of the pieces is an input vertex.
+//  * The new points are doubles chosen here (no rounding of anything computed): cut.new_points,
+//    numbered after the #P input points (the caller appends them to xyz).
 #pragma once
 
 #include <cstdint>
@@ -46,12 +51,18 @@ struct SolidCut {
   std::vector<Index> below, above;  ///< #T by 3 each, indices into xyz
   /// Per triangle of below / above: its index in the input `tri`, or -1 for a cap triangle.
   std::vector<Index> below_source, above_source;
-  std::int64_t loops = 0, cap_triangles = 0, cap_flips = 0;
+  /// The caps' own points (#N by 3); in below / above they are numbered #P, #P + 1, ...
+  std::vector<double> new_points;
+  std::int64_t loops = 0, cap_triangles = 0, cap_points = 0, cap_flips = 0;
 };
 
 /// See the contract above. Never throws on geometry (a refused cut has ok = false and a reason).
 SolidCut cut_solid(const std::vector<double>& xyz, const std::vector<Index>& tri, int axis, double threshold,
                    const std::vector<std::pair<Index, char>>& forced = {});
+
+/// For each corner i of `tri` (#T by 3): the triangle across the edge from corner i to the next
+/// corner of its triangle (the one holding that edge reversed), or -1.
+std::vector<Index> edge_neighbours(const std::vector<Index>& tri);
 
 /// The corner sum cut_solid compares with its threshold, for choosing thresholds.
 inline double corner_sum(const std::vector<double>& xyz, const Index* t, int axis) {
