@@ -3,7 +3,7 @@
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]
                    [--min-dihedral D] [--thickness-ratio K] [--surface-points exact|rounded] [--order 1|2]
                    [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
-                   [--max-memory SIZE] [--timeout SECONDS]
+                   [--max-memory SIZE] [--out-of-core] [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
     fembsptet compare INPUT [--size H] [--json FILE] [--plot FILE.png] [--timeout S] [--keep DIR]
     fembsptet benchmark MODELS_OR_FOLDERS... [--report FILE.md] [--divisions N] [--timeout S]
@@ -215,6 +215,9 @@ def _cmd_mesh(args):
     if getattr(args, "no_straighten_midnodes", False) and not getattr(args, "on_cad", False):
         raise InputError("--no-straighten-midnodes is for --on-cad (the FreeCAD mesher's curved "
                          "tet10); without --on-cad tet10 mid-nodes stay on their straight edges")
+    if getattr(args, "on_cad", False) and getattr(args, "out_of_core", False):
+        raise InputError("--out-of-core meshes a tessellation with the core alone; --on-cad runs the "
+                         "FreeCAD mesher's pipeline: use one of them")
     if getattr(args, "on_cad", False):
         progress("reading the CAD file")
         try:
@@ -227,6 +230,25 @@ def _cmd_mesh(args):
     surfaces = load_input(args.input, size=args.size)
     from . import core
 
+    if getattr(args, "out_of_core", False):
+        progress("tetrahedralizing in pieces")
+        try:
+            mesh, stats = core.tetrahedralize_out_of_core(
+                surfaces, args.max_memory_bytes,
+                options={k: v for k, v in (("size", args.size), ("min_size", args.min_size),
+                                           ("radius_edge", args.radius_edge),
+                                           ("min_dihedral", args.min_dihedral),
+                                           ("thickness_ratio", args.thickness_ratio),
+                                           ("surface_points", args.surface_points),
+                                           ("order", args.order),
+                                           ("allow_boundary_steiner", args.allow_boundary_steiner),
+                                           ("steiner_effort", args.steiner_effort),
+                                           ("bsp_seed", args.bsp_seed), ("reorient", args.reorient))
+                         if v not in (None, False) and not (k == "order" and v == 1)},
+                progress=progress)
+        finally:
+            progress.finish()
+        return _finish_mesh(args, progress, t0, mesh, stats, surfaces)
     progress("tetrahedralizing")
     try:
         mesh, stats = core.tetrahedralize(
@@ -480,6 +502,11 @@ def build_parser():
                    help="memory budget, e.g. 4G or 512M (default: the memory available now); a "
                         "run estimated to need more is refused before it starts, one that uses "
                         "more is stopped (exit 2)")
+    m.add_argument("--out-of-core", action="store_true",
+                   help="mesh in pieces small enough for --max-memory, one after the other, each "
+                        "written to disk before the next (the solid is cut along caps inside it; "
+                        "their points become interior nodes); the core's mesh only: no --size, "
+                        "quality or --order 2")
     m.add_argument("--timeout", metavar="SECONDS", type=float, default=None,
                    help="stop the run after this many seconds (exit 124; no output is written)")
     m.set_defaults(func=_cmd_mesh)

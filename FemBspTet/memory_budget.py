@@ -85,5 +85,6 @@ def require_within_budget(surfaces, budget, where=None):
             f"the surface has {len(biggest.triangles)} triangles: meshing it is estimated to need "
             f"about {format_bytes(worst)}, more than the memory budget of {format_bytes(budget)} "
             "(--max-memory, default: the memory available now); nothing was done. Raise the "
-            "budget, free memory, or mesh a coarser tessellation (--size for CAD input)",
+            "budget, free memory, mesh it in pieces within the budget (--out-of-core), or mesh "
+            "a coarser tessellation (--size for CAD input)",
             where=where or (biggest.source or None), estimate=worst, budget=budget)

@@ -9,6 +9,7 @@
 #include "bsptet/errors.h"
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesher.h"
+#include "bsptet/out_of_core.h"
 #include "bsptet/predicates.h"
 #include "bsptet/surface_check.h"
 #include "bsptet/quality_refine.h"
@@ -119,6 +120,22 @@ void run_without_gil(Options& o, const py::object& progress, const py::object& c
   o.progress = nullptr;
 }
 
+// The core options the bindings share (MeshOptions::seed, steiner_effort), validated.
+MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effort) {
+  MeshOptions o;
+  if (bsp_seed == "auto")
+    o.seed = MeshOptions::Seed::kAuto;
+  else if (bsp_seed == "delaunay")
+    o.seed = MeshOptions::Seed::kDelaunay;
+  else if (bsp_seed == "box")
+    o.seed = MeshOptions::Seed::kBox;
+  else
+    throw py::value_error("bsp_seed must be 'auto', 'delaunay' or 'box', got '" + bsp_seed + "'");
+  if (steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
+  o.steiner_effort = steiner_effort;
+  return o;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_bsptet, m) {
@@ -174,19 +191,9 @@ PYBIND11_MODULE(_bsptet, m) {
          py::object cancel, bool cone_cells, std::int64_t steiner_effort, const std::string& bsp_seed,
          py::object check) {
         const SurfaceMesh s = surface_from(points, triangles);
-        MeshOptions o;
+        MeshOptions o = core_options(bsp_seed, steiner_effort);
         o.allow_boundary_steiner = allow_boundary_steiner;
         o.cone_cells = cone_cells;
-        if (bsp_seed == "auto")
-          o.seed = MeshOptions::Seed::kAuto;
-        else if (bsp_seed == "delaunay")
-          o.seed = MeshOptions::Seed::kDelaunay;
-        else if (bsp_seed == "box")
-          o.seed = MeshOptions::Seed::kBox;
-        else
-          throw py::value_error("bsp_seed must be 'auto', 'delaunay' or 'box', got '" + bsp_seed + "'");
-        if (steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
-        o.steiner_effort = steiner_effort;
         TetMesh mesh;
         MeshStats st;
         if (check.is_none()) {
@@ -256,6 +263,48 @@ PYBIND11_MODULE(_bsptet, m) {
       "check: None, or a dict (reorient, max_reported_pairs) to check the surface as check_surface "
       "does, its self-intersection search beside the core (mesher.h check_and_tetrahedralize; the mesh "
       "is made from the checked triangles, re-oriented when reorient is set).");
+
+  // The out-of-core mode (out_of_core.h), issue 8.
+  m.def(
+      "tetrahedralize_in_pieces",
+      [](const DoubleArray& points, const IndexArray& triangles, const std::string& stem,
+         std::int64_t max_piece_triangles, py::object progress, py::object cancel, std::int64_t steiner_effort,
+         const std::string& bsp_seed, bool check_pieces) {
+        const SurfaceMesh s = surface_from(points, triangles);
+        MeshOptions o = core_options(bsp_seed, steiner_effort);
+        PieceOptions po;
+        po.max_piece_triangles = max_piece_triangles;
+        po.check_pieces = check_pieces;
+        PieceStats ps;
+        run_without_gil(o, progress, cancel, [&]() { tetrahedralize_in_pieces(s, o, po, stem, &ps); });
+        py::dict d;
+        d["pieces"] = ps.pieces;
+        d["cuts"] = ps.cuts;
+        d["cuts_refused"] = ps.cuts_refused;
+        d["cap_triangles"] = ps.cap_triangles;
+        d["cap_points"] = ps.cap_points;
+        d["largest_piece_triangles"] = ps.largest_piece_triangles;
+        d["max_piece_triangles"] = max_piece_triangles;
+        d["points"] = ps.points;
+        d["tets"] = ps.tets;
+        d["steiner_points"] = ps.steiner_points;
+        d["pieces_checked"] = ps.pieces_checked;
+        d["seconds_cutting"] = ps.seconds_cutting;
+        d["seconds_meshing"] = ps.seconds_meshing;
+        d["seconds_writing"] = ps.seconds_writing;
+        d["uncut"] = ps.uncut;
+        return d;
+      },
+      py::arg("points"), py::arg("triangles"), py::arg("stem"), py::arg("max_piece_triangles"),
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      py::arg("steiner_effort") = MeshOptions{}.steiner_effort, py::arg("bsp_seed") = "auto",
+      py::arg("check_pieces") = true,
+      "Meshes the solid bounded by a checked closed surface in pieces of at most max_piece_triangles "
+      "triangles, one after the other, streaming the mesh to stem.node / stem.ele (see out_of_core.h). "
+      "Returns a stats dict. Raises InputError or MeshingError; nothing is written then.");
+
+  m.def("piece_triangles_for_budget", &piece_triangles_for_budget, py::arg("budget_bytes"),
+        "The largest piece (triangles) the out-of-core mode's estimate fits in budget_bytes (out_of_core.h).");
 
   // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.

@@ -24,6 +24,7 @@ constexpr std::int64_t kBaseBytes = 32LL << 20;
 constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
 constexpr int kRepairRounds = 8;
 constexpr std::size_t kMaxCandidates = 27;
+constexpr std::int64_t kCapEdgeWeight = 2;
 constexpr std::int64_t kMaxRepairPairs = 100000;
 
 // A piece's own surface: the input vertices its triangles use (ascending input ids, returned in
@@ -97,22 +98,30 @@ std::vector<Index> cap_crossings(const std::vector<double>& points, const std::v
 }
 
 // Cuts the piece `tri` in two (below, above) by the first cut that solid_cut makes and that
-// check_surface accepts on both sides (candidates below). Where a cap crosses a surface
+// check_surface accepts on both sides (candidates below; points from first_cap_point on are
+// earlier caps'). Where a cap crosses a surface
 // triangle, the triangles around that triangle's vertices are moved to the other side and the
 // cut made again (at most kRepairRounds times). False when no cut works.
-bool cut_piece(std::vector<double>& points, const std::vector<Index>& tri, std::vector<Index>& below,
-               std::vector<Index>& above, PieceStats& st, const std::function<void(const std::string&)>& log) {
+bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::vector<Index>& tri,
+               std::vector<Index>& below, std::vector<Index>& above, PieceStats& st,
+               const std::function<void(const std::string&)>& log) {
   const std::size_t n = tri.size() / 3;
   // Candidate cuts: across each axis at the quantiles 0.3, 0.35, ..., 0.7 of the triangles'
   // corner sums, tried in order of how many edges join the two sides before smoothing (a plane
   // that grazes the surface, or crosses long thin triangles, gives long zigzag loops whose caps
   // cross the surface).
   const std::vector<Index> across = edge_neighbours(tri);
+  // Loop edges on an earlier cap count kCapEdgeWeight more: a loop that runs onto a flat cap,
+  // along its rim, folds in projection more often than one on the surface (but cutting only in
+  // parallel slabs would make caps a large part of thin pieces).
   struct Candidate {
-    std::int64_t loop_edges;
+    std::int64_t cap_edges, loop_edges;
     int axis;
     double threshold;
   };
+  std::vector<char> touches_cap(n);
+  for (std::size_t t = 0; t < n; ++t)
+    for (int k = 0; k < 3; ++k) touches_cap[t] = touches_cap[t] || tri[3 * t + k] >= first_cap_point;
   std::vector<Candidate> candidates;
   std::vector<double> sums(n), sorted(n);
   for (int axis = 0; axis < 3; ++axis) {
@@ -125,14 +134,19 @@ bool cut_piece(std::vector<double>& points, const std::vector<Index>& tri, std::
       bool seen = false;
       for (const auto& c : candidates) seen = seen || (c.axis == axis && c.threshold == threshold);
       if (seen) continue;
-      std::int64_t count = 0;
-      for (std::size_t i = 0; i < across.size(); ++i)
-        count += across[i] >= 0 && (sums[i / 3] < threshold) != (sums[static_cast<std::size_t>(across[i])] < threshold);
-      candidates.push_back({count / 2, axis, threshold});
+      std::int64_t count = 0, on_caps = 0;
+      for (std::size_t i = 0; i < across.size(); ++i) {
+        const std::size_t t = i / 3, s = static_cast<std::size_t>(across[i]);
+        if (across[i] < 0 || (sums[t] < threshold) == (sums[s] < threshold)) continue;
+        ++count;
+        on_caps += touches_cap[t] || touches_cap[s];
+      }
+      candidates.push_back({on_caps / 2, count / 2, axis, threshold});
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.loop_edges < b.loop_edges; });
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.loop_edges + kCapEdgeWeight * a.cap_edges < b.loop_edges + kCapEdgeWeight * b.cap_edges;
+  });
   if (candidates.size() > kMaxCandidates) candidates.resize(kMaxCandidates);
   std::vector<std::array<Index, 2>> pairs;
   for (const Candidate& candidate : candidates) {
@@ -254,7 +268,7 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
     if (options.progress) options.progress("cutting into pieces", 0);
     std::vector<Index> below, above;
     const std::size_t refused_before = st.refused.size();
-    if (!cut_piece(points, tri, below, above, st, po.log)) {
+    if (!cut_piece(points, surface.num_points(), tri, below, above, st, po.log)) {
       std::string reasons;
       for (std::size_t i = std::max(refused_before, st.refused.size() >= 3 ? st.refused.size() - 3 : 0); i < st.refused.size(); ++i)
         reasons += "\n  " + st.refused[i];

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <cstdint>
 #include <functional>
 #include <iterator>
@@ -16,7 +17,8 @@ namespace bsptet {
 namespace {
 
 constexpr int kSmoothingRounds = 16;
-constexpr double kCapSpacing = 2.0;
+constexpr double kSteepEdge = 4.0;
+constexpr double kCapSpacing = 4.0;
 constexpr double kCollarDepth = 0.5;
 constexpr double kMaxCapGrid = 4e6;
 
@@ -358,8 +360,8 @@ bool bridge_hole(const std::vector<Vec3>& p, const std::vector<Index>& ids, cons
 // Points inside the cap. First a collar: for each polygon edge a -> b, a point half the edge's
 // length inside it in the flat coordinates, at the mean of a and b along the axis (so that the
 // cap near the loop is made of triangles on loop edges, not of chords between loop vertices,
-// which run along the surface and may cross it where the surface is curved). Then a grid of
-// spacing kCapSpacing times the median flat edge length, without the cells along the loop, at
+// which run along the surface and may cross it where the surface is curved). Then a triangular
+// lattice of spacing kCapSpacing times the median flat edge length, without the cells along the loop, at
 // `level` along the axis. Each point is inserted where it falls strictly inside the
 // triangulation (else skipped). Returns how many were added (the triangulation's last points).
 std::int64_t add_cap_points(CapTriangulation& cap, std::size_t m, const Projection& pr, double level) {
@@ -385,30 +387,33 @@ std::int64_t add_cap_points(CapTriangulation& cap, std::size_t m, const Projecti
   double h = kCapSpacing * lengths[m / 2];
   if (!(h > 0) || !std::isfinite(h)) return added;
   while ((hi_u - lo_u) / h * ((hi_v - lo_v) / h) > kMaxCapGrid) h *= 2;
-  const long nu = static_cast<long>((hi_u - lo_u) / h) + 1, nv = static_cast<long>((hi_v - lo_v) / h) + 1;
+  // A triangular lattice (rows hv apart, every other row shifted by h / 2): its Delaunay
+  // triangulation is unique (no four points on a circle), unlike a square grid's.
+  const double hv = h * 0.8660254037844386;
+  const long nu = static_cast<long>((hi_u - lo_u) / h) + 1, nv = static_cast<long>((hi_v - lo_v) / hv) + 1;
   if (nu < 3 || nv < 3) return added;
-  std::vector<char> near_loop(static_cast<std::size_t>(nu * nv));
+  std::vector<char> near_loop(static_cast<std::size_t>(nu * nv));  // cell (i, j) at near_loop[j * nu + i]
   auto mark = [&](double x, double y) {
-    const long i = static_cast<long>((x - lo_u) / h), j = static_cast<long>((y - lo_v) / h);
-    for (long a = std::max(0L, i - 1); a <= std::min(nu - 1, i + 1); ++a)
-      for (long b = std::max(0L, j - 1); b <= std::min(nv - 1, j + 1); ++b) near_loop[a * nv + b] = 1;
+    const long i = static_cast<long>((x - lo_u) / h), j = static_cast<long>((y - lo_v) / hv);
+    for (long b = std::max(0L, j - 1); b <= std::min(nv - 1, j + 1); ++b)
+      for (long a = std::max(0L, i - 1); a <= std::min(nu - 1, i + 1); ++a) near_loop[b * nu + a] = 1;
   };
   for (std::size_t i = 0; i < m; ++i) {
     const Vec3 &a = p[i], &b = p[(i + 1) % m];
-    const long steps = static_cast<long>(2 * std::hypot(b[u] - a[u], b[v] - a[v]) / h) + 1;
+    const long steps = static_cast<long>(2 * std::hypot(b[u] - a[u], b[v] - a[v]) / hv) + 1;
     for (long s = 0; s <= steps; ++s) {
       const double f = static_cast<double>(s) / static_cast<double>(steps);
       mark(a[u] + f * (b[u] - a[u]), a[v] + f * (b[v] - a[v]));
     }
   }
-  for (long i = 0; i < nu; ++i)
-    for (long jj = 0; jj < nv; ++jj) {
-      const long j = i % 2 ? nv - 1 - jj : jj;  // serpentine: each point next to the last
-      if (near_loop[i * nv + j]) continue;
+  for (long j = 0; j < nv; ++j)
+    for (long ii = 0; ii < nu; ++ii) {
+      const long i = j % 2 ? nu - 1 - ii : ii;  // serpentine: each point next to the last
+      if (near_loop[j * nu + i]) continue;
       double c[3];
       c[pr.axis] = level;
-      c[u] = lo_u + (static_cast<double>(i) + 0.5) * h + pr.d[u] * level;
-      c[v] = lo_v + (static_cast<double>(j) + 0.5) * h + pr.d[v] * level;
+      c[u] = lo_u + (static_cast<double>(i) + (j % 2 ? 0.75 : 0.25)) * h + pr.d[u] * level;
+      c[v] = lo_v + (static_cast<double>(j) + 0.5) * hv + pr.d[v] * level;
       added += cap.insert({c[0], c[1], c[2]});
     }
   return added;
@@ -452,12 +457,34 @@ SolidCut cut_solid(const std::vector<double>& xyz, const std::vector<Index>& tri
     for (auto it = std::lower_bound(corners.begin(), corners.end(), std::pair<Index, Index>{vertex, -1});
          it != corners.end() && it->first == vertex; ++it)
       below[it->second] = side;
+  const int au = (axis + 1) % 3, av = (axis + 2) % 3;
+  auto coord = [&](Index v, int a) { return xyz[3 * static_cast<std::size_t>(v) + a]; };
   for (int round = 0; round < kSmoothingRounds; ++round) {
     bool changed = false;
     for (std::size_t t = 0; t < n; ++t) {
       int other = 0;
       for (int k = 0; k < 3; ++k) other += below[across[3 * t + k]] != below[t];
       if (other >= 2) below[t] = !below[t], changed = true;
+    }
+    // A boundary edge much steeper along the axis than across it (along a crease, an earlier
+    // cap's rim or a long strip parallel to the axis) folds the loop's projection: its two
+    // triangles join the side where the edge's middle lies.
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!below[t]) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Index s = across[3 * t + k];
+        if (below[s]) continue;
+        const Index a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3];
+        const double rise = std::fabs(coord(a, axis) - coord(b, axis));
+        const double run = std::fabs(coord(a, au) - coord(b, au)) + std::fabs(coord(a, av) - coord(b, av));
+        if (!(rise > kSteepEdge * run)) continue;
+        if (coord(a, axis) + coord(b, axis) < 2 * level)
+          below[s] = 1;
+        else
+          below[t] = 0;
+        changed = true;
+        break;
+      }
     }
     for (std::size_t i = 0, j; i < corners.size(); i = j) {
       int sides = 0, lower = 0, count = 0;  // boundary edges at the vertex (each fan edge counted once)
