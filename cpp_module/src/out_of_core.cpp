@@ -110,7 +110,8 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
   // corner sums, tried in order of how many edges join the two sides before smoothing (a plane
   // that grazes the surface, or crosses long thin triangles, gives long zigzag loops whose caps
   // cross the surface).
-  const std::vector<Index> across = edge_neighbours(tri);
+  const SolidTopology topology(tri);
+  const std::vector<Index>& across = topology.across;
   // Loop edges on an earlier cap count kCapEdgeWeight more: a loop that runs onto a flat cap,
   // along its rim, folds in projection more often than one on the surface (but cutting only in
   // parallel slabs would make caps a large part of thin pieces).
@@ -157,7 +158,7 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
     std::vector<std::pair<Index, char>> forced;
     std::string why;
     for (int round = 0; round <= kRepairRounds && why.empty(); ++round) {
-      SolidCut cut = cut_solid(points, tri, axis, threshold, forced);
+      SolidCut cut = cut_solid(points, tri, axis, threshold, forced, &topology);
       if (!cut.ok) {
         why = cut.reason;
         break;

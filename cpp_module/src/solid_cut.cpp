@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <iterator>
+#include <memory>
 #include <unordered_map>
 
 #include "bsptet/exact_float.h"
@@ -22,27 +23,6 @@ constexpr double kCapSpacing = 4.0;
 constexpr double kCollarDepth = 0.5;
 constexpr double kMaxCapGrid = 4e6;
 
-// The directed edges of a triangle list, sorted: the triangle holding u -> v.
-class DirectedEdges {
- public:
-  explicit DirectedEdges(const std::vector<Index>& tri) : edges_(tri.size()) {
-    for (std::size_t t = 0; t < tri.size() / 3; ++t)
-      for (int k = 0; k < 3; ++k) edges_[3 * t + k] = {tri[3 * t + k], tri[3 * t + (k + 1) % 3], static_cast<Index>(t)};
-    std::sort(edges_.begin(), edges_.end(), by_ends);
-  }
-  /// The triangle that holds the directed edge u -> v, or -1.
-  Index triangle_of(Index u, Index v) const {
-    auto it = std::lower_bound(edges_.begin(), edges_.end(), Edge{u, v, 0}, by_ends);
-    return it != edges_.end() && it->u == u && it->v == v ? it->t : -1;
-  }
-
- private:
-  struct Edge {
-    Index u, v, t;
-  };
-  static bool by_ends(const Edge& e, const Edge& f) { return e.u != f.u ? e.u < f.u : e.v < f.v; }
-  std::vector<Edge> edges_;
-};
 
 // The caps' projection: along d = e_axis + tilt_u e_u + tilt_v e_v, the cut's axis or a direction
 // a little off it (a plane that contains the axis, such as a CAD face or an earlier cap, projects
@@ -419,40 +399,58 @@ std::int64_t add_cap_points(CapTriangulation& cap, std::size_t m, const Projecti
   return added;
 }
 
-// edge_neighbours (solid_cut.h) from the sorted directed edges of `tri`.
-std::vector<Index> neighbours(const DirectedEdges& edges, const std::vector<Index>& tri) {
-  std::vector<Index> across(tri.size());
-  for (std::size_t i = 0; i < tri.size(); ++i) across[i] = edges.triangle_of(tri[i / 3 * 3 + (i + 1) % 3], tri[i]);
-  return across;
-}
 
 }  // namespace
 
-std::vector<Index> edge_neighbours(const std::vector<Index>& tri) { return neighbours(DirectedEdges(tri), tri); }
+SolidTopology::SolidTopology(const std::vector<Index>& tri) {
+  const std::size_t n = tri.size() / 3;
+  edges.resize(tri.size());
+  corners.resize(tri.size());
+  for (std::size_t t = 0; t < n; ++t)
+    for (int k = 0; k < 3; ++k) {
+      edges[3 * t + k] = {tri[3 * t + k], tri[3 * t + (k + 1) % 3], static_cast<Index>(t)};
+      corners[3 * t + k] = {tri[3 * t + k], static_cast<Index>(t)};
+    }
+  std::sort(edges.begin(), edges.end(), [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
+    return e[0] != f[0] ? e[0] < f[0] : e[1] < f[1];
+  });
+  std::sort(corners.begin(), corners.end());
+  across.resize(tri.size());
+  for (std::size_t i = 0; i < tri.size(); ++i) across[i] = triangle_of(tri[i / 3 * 3 + (i + 1) % 3], tri[i]);
+}
+
+Index SolidTopology::triangle_of(Index u, Index v) const {
+  auto it = std::lower_bound(edges.begin(), edges.end(), std::array<Index, 3>{u, v, 0},
+                             [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
+                               return e[0] != f[0] ? e[0] < f[0] : e[1] < f[1];
+                             });
+  return it != edges.end() && (*it)[0] == u && (*it)[1] == v ? (*it)[2] : -1;
+}
+
+std::vector<Index> edge_neighbours(const std::vector<Index>& tri) { return SolidTopology(tri).across; }
 
 SolidCut cut_solid(const std::vector<double>& xyz, const std::vector<Index>& tri, int axis, double threshold,
-                   const std::vector<std::pair<Index, char>>& forced) {
+                   const std::vector<std::pair<Index, char>>& forced, const SolidTopology* topology) {
+  std::unique_ptr<SolidTopology> own;
+  if (!topology) own = std::make_unique<SolidTopology>(tri), topology = own.get();
+  const SolidTopology& topo = *topology;
   SolidCut cut;
   const std::size_t n = tri.size() / 3;
   const double level = threshold / 3;  // where the cap's own points go along `axis`
   std::vector<char> below(n);
   std::size_t n_below = 0;
   for (std::size_t t = 0; t < n; ++t) n_below += below[t] = corner_sum(xyz, &tri[3 * t], axis) < threshold;
-  const DirectedEdges edges(tri);
-  auto triangle_of = [&](Index u, Index v) { return edges.triangle_of(u, v); };
+  auto triangle_of = [&](Index u, Index v) { return topo.triangle_of(u, v); };
   // Smoothing (see the header): spikes and pinches of the boundary between the sides would give
   // a cap triangle equal to a surface triangle, or loops through one vertex.
-  std::vector<Index> across = neighbours(edges, tri);
+  const std::vector<Index>& across = topo.across;
   for (std::size_t i = 0; i < across.size(); ++i)
     if (across[i] < 0) {
       cut.reason = "edge " + std::to_string(tri[i]) + "-" + std::to_string(tri[i / 3 * 3 + (i + 1) % 3]) +
                    " has one triangle (the surface is not closed)";
       return cut;
     }
-  std::vector<std::pair<Index, Index>> corners(3 * n);  // (vertex, triangle), sorted: each vertex's fan
-  for (std::size_t t = 0; t < n; ++t)
-    for (int k = 0; k < 3; ++k) corners[3 * t + k] = {tri[3 * t + k], static_cast<Index>(t)};
-  std::sort(corners.begin(), corners.end());
+  const std::vector<std::pair<Index, Index>>& corners = topo.corners;  // each vertex's fan
   for (const auto& [vertex, side] : forced)
     for (auto it = std::lower_bound(corners.begin(), corners.end(), std::pair<Index, Index>{vertex, -1});
          it != corners.end() && it->first == vertex; ++it)
@@ -501,8 +499,6 @@ SolidCut cut_solid(const std::vector<double>& xyz, const std::vector<Index>& tri
     }
     if (!changed) break;
   }
-  corners = {};
-  across = {};
   n_below = static_cast<std::size_t>(std::count(below.begin(), below.end(), 1));
   if (n_below == 0 || n_below == n) {
     cut.reason = "every triangle is on one side of the cut";

@@ -36,6 +36,7 @@
 //    numbered after the #P input points (the caller appends them to xyz).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -56,9 +57,21 @@ struct SolidCut {
   std::int64_t loops = 0, cap_triangles = 0, cap_points = 0, cap_flips = 0;
 };
 
+/// The adjacency of a closed triangle list that cut_solid needs, the same for every cut of it:
+/// made once per piece when several cuts are tried.
+struct SolidTopology {
+  explicit SolidTopology(const std::vector<Index>& tri);
+  /// The triangle holding the directed edge u -> v, or -1.
+  Index triangle_of(Index u, Index v) const;
+  std::vector<std::array<Index, 3>> edges;        ///< (u, v, triangle) per directed edge, sorted by (u, v)
+  std::vector<Index> across;                      ///< as edge_neighbours
+  std::vector<std::pair<Index, Index>> corners;  ///< (vertex, triangle), sorted: each vertex's fan
+};
+
 /// See the contract above. Never throws on geometry (a refused cut has ok = false and a reason).
+/// `topology`: SolidTopology(tri), or null to have it made here.
 SolidCut cut_solid(const std::vector<double>& xyz, const std::vector<Index>& tri, int axis, double threshold,
-                   const std::vector<std::pair<Index, char>>& forced = {});
+                   const std::vector<std::pair<Index, char>>& forced = {}, const SolidTopology* topology = nullptr);
 
 /// For each corner i of `tri` (#T by 3): the triangle across the edge from corner i to the next
 /// corner of its triangle (the one holding that edge reversed), or -1.
