@@ -24,7 +24,7 @@ constexpr std::int64_t kBaseBytes = 32LL << 20;
 constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
 constexpr int kRepairRounds = 8;
 constexpr std::size_t kMaxCandidates = 27;
-constexpr std::int64_t kCapEdgeWeight = 2;
+constexpr double kCapEdgeWeight = 3.0;
 constexpr std::int64_t kMaxRepairPairs = 100000;
 
 // A piece's own surface: the input vertices its triangles use (ascending input ids, returned in
@@ -107,22 +107,28 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
                const std::function<void(const std::string&)>& log) {
   const std::size_t n = tri.size() / 3;
   // Candidate cuts: across each axis at the quantiles 0.3, 0.35, ..., 0.7 of the triangles'
-  // corner sums, tried in order of how many edges join the two sides before smoothing (a plane
-  // that grazes the surface, or crosses long thin triangles, gives long zigzag loops whose caps
-  // cross the surface).
+  // corner sums.
   const SolidTopology topology(tri);
   const std::vector<Index>& across = topology.across;
-  // Loop edges on an earlier cap count kCapEdgeWeight more: a loop that runs onto a flat cap,
-  // along its rim, folds in projection more often than one on the surface (but cutting only in
-  // parallel slabs would make caps a large part of thin pieces).
+  // Ordered by the length of the edges between the two sides before smoothing, those on an
+  // earlier cap counted kCapEdgeWeight times: a plane that grazes the surface or crosses long
+  // thin triangles (a CAD strip along the axis) makes a long zigzag loop whose cap has needles
+  // and crosses the surface; a loop that runs onto a flat cap, along its rim, folds in projection
+  // more often than one on the surface (but weighing caps more than that would favour parallel
+  // slabs, whose caps become a large part of thin pieces).
   struct Candidate {
-    std::int64_t cap_edges, loop_edges;
+    double weight;
     int axis;
     double threshold;
   };
   std::vector<char> touches_cap(n);
   for (std::size_t t = 0; t < n; ++t)
     for (int k = 0; k < 3; ++k) touches_cap[t] = touches_cap[t] || tri[3 * t + k] >= first_cap_point;
+  std::vector<double> edge_length(across.size());
+  for (std::size_t i = 0; i < across.size(); ++i) {
+    const std::size_t a = 3 * static_cast<std::size_t>(tri[i]), b = 3 * static_cast<std::size_t>(tri[i / 3 * 3 + (i + 1) % 3]);
+    edge_length[i] = std::hypot(points[a] - points[b], points[a + 1] - points[b + 1], points[a + 2] - points[b + 2]);
+  }
   std::vector<Candidate> candidates;
   std::vector<double> sums(n), sorted(n);
   for (int axis = 0; axis < 3; ++axis) {
@@ -135,19 +141,17 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
       bool seen = false;
       for (const auto& c : candidates) seen = seen || (c.axis == axis && c.threshold == threshold);
       if (seen) continue;
-      std::int64_t count = 0, on_caps = 0;
+      double weight = 0;
       for (std::size_t i = 0; i < across.size(); ++i) {
         const std::size_t t = i / 3, s = static_cast<std::size_t>(across[i]);
         if (across[i] < 0 || (sums[t] < threshold) == (sums[s] < threshold)) continue;
-        ++count;
-        on_caps += touches_cap[t] || touches_cap[s];
+        weight += edge_length[i] * (touches_cap[t] || touches_cap[s] ? kCapEdgeWeight : 1);
       }
-      candidates.push_back({on_caps / 2, count / 2, axis, threshold});
+      candidates.push_back({weight, axis, threshold});
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-    return a.loop_edges + kCapEdgeWeight * a.cap_edges < b.loop_edges + kCapEdgeWeight * b.cap_edges;
-  });
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.weight < b.weight; });
   if (candidates.size() > kMaxCandidates) candidates.resize(kMaxCandidates);
   std::vector<std::array<Index, 2>> pairs;
   for (const Candidate& candidate : candidates) {
