@@ -72,7 +72,10 @@ def run_tetgen(off, workdir, timeout):
     from FemBspTet.compare.process import run_measured
 
     local = os.path.join(workdir, "tetgen_input.off")
-    shutil.copyfile(off, local)
+    with open(off, encoding="ascii") as src, open(local, "w", encoding="ascii") as dst:
+        for line in src:  # TetGen 1.5 aborts on OFF comment lines
+            if not line.lstrip().startswith("#"):
+                dst.write(line)
     run = run_measured(["tetgen", "-pYQ", local], timeout=timeout, cwd=workdir)
     row = {"seconds": run.seconds, "peak_mb": run.peak_rss_mb, "status": "ok", "message": ""}
     if run.timed_out:
