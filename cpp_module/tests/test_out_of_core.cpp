@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "bsptet/errors.h"
 #include "bsptet/exact_float.h"
 #include "bsptet/mesh_check.h"
@@ -25,8 +27,10 @@ namespace {
 
 std::string data(const std::string& rel) { return std::string(FEMBSPTET_DATA_DIR) + "/" + rel; }
 
+// A scratch file stem of this process (ctest runs the tests as parallel processes).
 std::string scratch(const std::string& name) {
-  return (testing::TempDir().empty() ? std::string("/tmp/") : testing::TempDir()) + "bsptet_ooc_" + name;
+  return (testing::TempDir().empty() ? std::string("/tmp/") : testing::TempDir()) + "bsptet_ooc_" +
+         std::to_string(getpid()) + "_" + name;
 }
 
 bool exists(const std::string& path) { return std::ifstream(path).good(); }
