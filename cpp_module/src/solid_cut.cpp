@@ -1,4 +1,4 @@
-// FemBspTet core: cutting a solid in two along caps made of its own vertices (solid_cut.h).
+// FemBspTet core: cutting a solid in two along caps of its own vertices and new points (solid_cut.h).
 #include "bsptet/solid_cut.h"
 
 #include <algorithm>

@@ -11,13 +11,14 @@
 // Contract:
 //  * `surface` is a closed oriented surface that check_surface (surface_check.h) accepts as it is
 //    (outward, no self-intersection): the caller checks it first.
-//  * Cuts (solid_cut.h): a piece with more than max_piece_triangles triangles is cut across its
-//    longest extent, at the median of its triangles' corner sums, else at other quantiles and
-//    across the other axes, until both halves pass check_surface exactly (caps that cross the
-//    surface, folded or holed cross-sections are refused there). A piece of at most
-//    min_piece_triangles is never cut. A piece that no tried cut splits is meshed whole, and
+//  * Cuts (solid_cut.h): a piece with more than max_piece_triangles triangles is cut. The
+//    candidates are the 3 axes by the quantiles 0.3, 0.35, ..., 0.7 of its triangles' corner
+//    sums, tried shortest cut first (the length of the edges between the sides, those on an
+//    earlier cap counted three times), until both halves pass check_surface exactly (caps that
+//    cross the surface are first repaired, up to 8 times; folded cross-sections and caps that
+//    still cross the surface are refused). A piece of at most min_piece_triangles is never cut. A piece that no tried cut splits is meshed whole, and
 //    PieceStats::uncut says so (its run may then need more memory than the budget meant).
-//  * The caps are made of input vertices and every piece is meshed with no Steiner point on its
+//  * The caps are made of input vertices and points of their own, and every piece is meshed with no Steiner point on its
 //    boundary (MeshOptions::allow_boundary_steiner must be false), so two pieces meet in exactly
 //    their caps' triangles: the union of the pieces' meshes is a conforming mesh of the solid
 //    (its boundary the input triangles, the caps inside it as interior faces).
