@@ -1,4 +1,4 @@
-// FemBspTet core: cutting a solid in two along a surface made of its own vertices, for the
+// FemBspTet core: cutting a solid in two along caps of its own vertices and points of their own, for the
 // out-of-core mode (out_of_core.h), which meshes the pieces one after the other.
 //
 //   SolidCut cut = cut_solid(xyz, tri, axis, threshold);   // cut.ok: cut.below, cut.above
