@@ -23,7 +23,6 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 constexpr std::int64_t kBaseBytes = 32LL << 20;
 constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
 constexpr int kRepairRounds = 8;
-constexpr std::size_t kMaxCandidates = 27;
 constexpr double kCapEdgeWeight = 3.0;
 constexpr std::int64_t kMaxRepairPairs = 100000;
 
@@ -42,17 +41,11 @@ SurfaceMesh local_surface(const std::vector<double>& points, const std::vector<I
   return s;
 }
 
-// Empty when check_surface accepts the piece as it is, else its message; `pairs` receives the
-// intersecting triangle pairs (piece triangle indices) when that is the problem.
-std::string surface_problem(const std::vector<double>& points, const std::vector<Index>& tri,
-                            std::vector<std::array<Index, 2>>& pairs) {
+// Empty when check_surface accepts the piece as it is, else its message.
+std::string surface_problem(const std::vector<double>& points, const std::vector<Index>& tri) {
   std::vector<Index> globals;
-  pairs.clear();
   try {
     check_surface(local_surface(points, tri, globals));
-  } catch (const SelfIntersectionError& e) {
-    pairs = e.pairs();
-    return e.what();
   } catch (const InputError& e) {
     return e.what();
   }
@@ -72,9 +65,7 @@ std::vector<Index> cap_crossings(const std::vector<double>& points, const std::v
           const double x = points[3 * static_cast<std::size_t>(piece[3 * t + k]) + a];
           lo[a] = std::min(lo[a], x), hi[a] = std::max(hi[a], x);
         }
-  SurfaceMesh near;
-  near.xyz = points;
-  std::vector<Index> from;  // near's triangle -> piece triangle
+  std::vector<Index> near, from;  // the triangles near the caps; near's triangle -> piece triangle
   for (std::size_t t = 0; t < source.size(); ++t) {
     bool meets = true;
     for (int a = 0; a < 3 && meets; ++a) {
@@ -86,11 +77,12 @@ std::vector<Index> cap_crossings(const std::vector<double>& points, const std::v
       meets = l <= hi[a] && h >= lo[a];
     }
     if (!meets) continue;
-    near.tri.insert(near.tri.end(), &piece[3 * t], &piece[3 * t + 3]);
+    near.insert(near.end(), &piece[3 * t], &piece[3 * t + 3]);
     from.push_back(static_cast<Index>(t));
   }
+  std::vector<Index> globals;
   std::vector<Index> crossed;
-  for (const auto& pair : find_self_intersections(near, kMaxRepairPairs)) {
+  for (const auto& pair : find_self_intersections(local_surface(points, near, globals), kMaxRepairPairs)) {
     const Index a = source[from[pair[0]]], b = source[from[pair[1]]];
     if ((a < 0) != (b < 0)) crossed.push_back(a < 0 ? b : a);
   }
@@ -152,8 +144,6 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
   }
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.weight < b.weight; });
-  if (candidates.size() > kMaxCandidates) candidates.resize(kMaxCandidates);
-  std::vector<std::array<Index, 2>> pairs;
   for (const Candidate& candidate : candidates) {
     const int axis = candidate.axis;
     const double threshold = candidate.threshold;
@@ -185,8 +175,8 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
                                           std::to_string(kRepairRounds) + " repairs";
         continue;
       }
-      why = surface_problem(points, cut.below, pairs);
-      if (why.empty()) why = surface_problem(points, cut.above, pairs);
+      why = surface_problem(points, cut.below);
+      if (why.empty()) why = surface_problem(points, cut.above);
       if (!why.empty()) {
         points.resize(old_size);
         break;
