@@ -13,7 +13,10 @@ PACKAGES=(
   # Python side
   python3-numpy python3-meshio python3-matplotlib
   # FreeCAD FEM and the peers we compare with or solve with
-  freecad-python3 gmsh python3-gmsh tetgen calculix-ccx
+  freecad-python3 gmsh python3-gmsh tetgen calculix-ccx python3-netgen
+  # the CAD layer (cpp_module/src/cad): OpenCASCADE's headers and libraries
+  libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev libocct-data-exchange-dev
+  libtbb-dev  # named by OpenCASCADE's CMake targets
   # peak memory of each mesher's process in the comparison (GNU time)
   time
 )

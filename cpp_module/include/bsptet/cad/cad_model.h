@@ -1,0 +1,51 @@
+// FemBspTet CAD layer: a CAD shape read through OpenCASCADE, with its topology numbered.
+//
+//   CadModel read_cad_file(const std::string& path)       // .step .stp .brep .brp .iges .igs
+//   CadModel read_brep_string(const std::string& brep)    // FreeCAD's Shape.exportBrepToString()
+//
+// Numbering, stated once for the CAD layer: solids, faces, edges and vertices are numbered by
+// OpenCASCADE's TopExp::MapShapes over the whole shape, the order FreeCAD's Shape.Faces (Face1,
+// Face2, ...) uses. Indices here are 0-based: face k is FreeCAD's "Face<k+1>" and the surface
+// tag of its triangles. A face shared by two solids of a CompSolid has one index.
+//
+// This layer is the only one that links OpenCASCADE; nothing below it (mesh, core, refine) does.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS_Shape.hxx>
+
+namespace bsptet::cad {
+
+struct CadModel {
+  TopoDS_Shape shape;
+  TopTools_IndexedMapOfShape solids, faces, edges, vertices;  ///< 1-based maps (OCC's own)
+  std::string source;  ///< the file name, or "BREP string": named in messages
+
+  int num_solids() const { return solids.Extent(); }
+  int num_faces() const { return faces.Extent(); }
+  int num_edges() const { return edges.Extent(); }
+  int num_vertices() const { return vertices.Extent(); }
+  /// 0-based indices of a sub-shape (orientation ignored), -1 when it is not in the model.
+  int face_index(const TopoDS_Shape& f) const { return faces.FindIndex(f) - 1; }
+  int edge_index(const TopoDS_Shape& e) const { return edges.FindIndex(e) - 1; }
+  int vertex_index(const TopoDS_Shape& v) const { return vertices.FindIndex(v) - 1; }
+  /// Axis-aligned bounding box diagonal of the shape (model units).
+  double diagonal() const;
+};
+
+/// Reads a STEP, BREP or IGES file (chosen by extension, case-insensitive). Throws InputError
+/// naming the file when it cannot be read, is empty, or holds no solid (the message says what it
+/// holds instead: shells, faces, ...).
+CadModel read_cad_file(const std::string& path);
+
+/// Reads a shape in OpenCASCADE's BREP text format (what FreeCAD's Shape.exportBrepToString()
+/// gives). Same errors as read_cad_file.
+CadModel read_brep_string(const std::string& brep, const std::string& source = "BREP string");
+
+/// Numbers an existing shape's topology (no copy of the geometry). Same errors.
+CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source);
+
+}  // namespace bsptet::cad

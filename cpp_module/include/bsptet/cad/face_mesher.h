@@ -1,0 +1,62 @@
+// FemBspTet CAD layer: triangles of one CAD face at the size field, its boundary nodes fixed.
+//
+//   FaceMesh mesh_face(forward_face, loops, options, first_new_node)
+//
+// Method (in the face's parameter plane, lengths and shapes measured in 3D on the surface, as
+// Gmsh's MeshAdapt does):
+//  1. the boundary loops (the nodes of the face's edges, at their pcurve parameters) are
+//     triangulated in (u, v) by ear cutting (uv_polygon.h);
+//  2. rounds of local operations, each kept only when every triangle it makes turns
+//     counter-clockwise in (u, v) (exact orient2d): interior edges longer than 1.4 times the local
+//     size are split at their (u, v) midpoint (the new node evaluated on the surface), edges
+//     shorter than 0.7 times it are collapsed onto a neighbour (interior nodes only), edges are
+//     flipped when that raises the smaller shape quality of their two triangles, and interior
+//     nodes move towards the mean of their neighbours when that raises the worst quality around
+//     them. Shape quality is 4 sqrt(3) area / (sum of squared edge lengths) in 3D, 1 for an
+//     equilateral triangle, negative when the triangle's normal opposes the surface's (a fold).
+// Boundary nodes never move. Nodes of a degenerated edge (a cone apex, a sphere pole) share one
+// node id: triangles with two such corners are zero-area in 3D and are dropped at the end.
+//
+// Orientation: triangles turn counter-clockwise in (u, v) of the FORWARD face, so their right-hand
+// normal is the surface's S_u x S_v; the caller reverses them for a face REVERSED in its solid.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <TopoDS_Face.hxx>
+
+#include "bsptet/cad/uv_polygon.h"
+#include "bsptet/types.h"
+
+namespace bsptet::cad {
+
+/// A node on a face's boundary: its (u, v) on this face, its node id and 3D point.
+struct BoundaryNode {
+  Uv uv;
+  Index node;
+  Vec3 xyz;
+};
+
+struct FaceMeshOptions {
+  double face_size = 1;    ///< the face's size (SizeField::face_size)
+  double min_size = 0;     ///< never split edges shorter than 2 * min_size
+  double grading = 0.3;    ///< growth of the size away from the boundary nodes, per unit length
+  int max_rounds = 20;     ///< rounds of split / collapse / flip / smooth at most
+};
+
+struct FaceMesh {
+  std::vector<std::array<Index, 3>> triangles;  ///< node ids, counter-clockwise in (u, v)
+  std::vector<Vec3> new_xyz;                    ///< interior nodes: ids first_new_node + i
+  std::vector<Uv> new_uv;
+  int folds = 0;             ///< triangles left whose normal opposes the surface's
+  double min_quality = 1;    ///< smallest shape quality (see above)
+};
+
+/// loops: the outer boundary first (counter-clockwise in (u, v): the face on its left), then the
+/// holes (clockwise); no node repeated at a loop's end. Throws std::runtime_error when the
+/// boundary is not a simple polygon in (u, v); the caller names the face.
+FaceMesh mesh_face(const TopoDS_Face& forward_face, const std::vector<std::vector<BoundaryNode>>& loops,
+                   const FaceMeshOptions& options, Index first_new_node);
+
+}  // namespace bsptet::cad

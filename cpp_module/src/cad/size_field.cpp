@@ -1,0 +1,109 @@
+// FemBspTet CAD layer: the size field (see size_field.h).
+#include "bsptet/cad/size_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <BRepAdaptor_Curve.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepLProp_CLProps.hxx>
+#include <BRepLProp_SLProps.hxx>
+#include <BRepTools.hxx>
+#include <GeomAbs_SurfaceType.hxx>
+#include <TopoDS.hxx>
+
+#include "bsptet/errors.h"
+
+namespace bsptet::cad {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+void check_option(double value, const char* name) {
+  if (!std::isfinite(value) || value < 0) {
+    std::ostringstream what;
+    what << "option " << name << " must be a finite number >= 0, got " << value;
+    throw InputError(ErrorCode::kBadArgument, "size_field", -1, what.str());
+  }
+}
+
+/// Largest principal curvature of the face, sampled on a grid over its parameter bounds
+/// (analytic surfaces: their radius directly).
+double max_face_curvature(const TopoDS_Face& face) {
+  BRepAdaptor_Surface surface(face, /*restriction=*/true);
+  switch (surface.GetType()) {
+    case GeomAbs_Plane:
+      return 0;
+    case GeomAbs_Cylinder:
+      return 1.0 / surface.Cylinder().Radius();
+    case GeomAbs_Sphere:
+      return 1.0 / surface.Sphere().Radius();
+    case GeomAbs_Torus:
+      return 1.0 / surface.Torus().MinorRadius();
+    default:
+      break;
+  }
+  double u0, u1, v0, v1;
+  BRepTools::UVBounds(face, u0, u1, v0, v1);
+  constexpr int kSamples = 12;
+  BRepLProp_SLProps props(surface, 2, 1e-9);
+  double kmax = 0;
+  for (int i = 0; i <= kSamples; ++i) {
+    for (int j = 0; j <= kSamples; ++j) {
+      const double u = u0 + (u1 - u0) * i / kSamples, v = v0 + (v1 - v0) * j / kSamples;
+      props.SetParameters(u, v);
+      if (!props.IsCurvatureDefined()) continue;
+      const double k = std::max(std::abs(props.MaxCurvature()), std::abs(props.MinCurvature()));
+      if (std::isfinite(k)) kmax = std::max(kmax, k);
+    }
+  }
+  return kmax;
+}
+
+}  // namespace
+
+SizeField::SizeField(const CadModel& model, const SizeOptions& options) {
+  check_option(options.size, "size");
+  check_option(options.min_size, "min_size");
+  check_option(options.points_per_circle, "points_per_circle");
+  check_option(options.grading, "grading");
+  const double diagonal = model.diagonal();
+  size_ = options.size > 0 ? options.size : diagonal / 20;
+  min_size_ = options.min_size > 0 ? std::min(options.min_size, size_) : size_ / 50;
+  grading_ = options.grading > 0 ? options.grading : 0.3;
+  points_per_circle_ = options.points_per_circle;
+  face_size_.assign(static_cast<std::size_t>(model.num_faces()), size_);
+  for (int f = 0; f < model.num_faces(); ++f) {
+    double s = size_;
+    const auto it = options.size_by_face.find(f);
+    if (it != options.size_by_face.end() && it->second > 0) s = std::min(s, it->second);
+    if (points_per_circle_ > 0) {
+      const double k = max_face_curvature(TopoDS::Face(model.faces(f + 1)));
+      if (k > 0) s = std::min(s, kTwoPi / (k * points_per_circle_));
+    }
+    face_size_[static_cast<std::size_t>(f)] = clamp(s);
+  }
+}
+
+double SizeField::clamp(double s) const { return std::max(min_size_, std::min(size_, s)); }
+
+double SizeField::curve_curvature_size(const BRepAdaptor_Curve& curve, double t) const {
+  if (points_per_circle_ <= 0) return kInf;
+  switch (curve.GetType()) {
+    case GeomAbs_Line:
+      return kInf;
+    case GeomAbs_Circle:
+      return kTwoPi * curve.Circle().Radius() / points_per_circle_;
+    default:
+      break;
+  }
+  BRepLProp_CLProps props(curve, t, 2, 1e-9);
+  if (!props.IsTangentDefined()) return kInf;
+  const double k = std::abs(props.Curvature());
+  return k > 0 && std::isfinite(k) ? kTwoPi / (k * points_per_circle_) : kInf;
+}
+
+}  // namespace bsptet::cad
