@@ -8,8 +8,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -202,21 +200,24 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
   }
   progress("edges", 1.0);
 
-  // ---- Faces, each once. ----
-  const int n_faces = model.num_faces();
-  std::vector<std::vector<std::array<Index, 3>>> face_tris(static_cast<std::size_t>(n_faces));
-  CadSurfaceStats st;
-  for (int f = 0; f < n_faces; ++f) {
-    check_cancel();
+  // ---- Each face's boundary loops in its parameter plane. ----
+  // seg[l][i] names the edge segment from loops[l][i] to the next node: (edge, index of the
+  // segment in the edge's FORWARD node list), edge -1 on a degenerated edge.
+  struct FaceLoops {
+    std::vector<std::vector<BoundaryNode>> loops;
+    std::vector<std::vector<std::array<int, 2>>> seg;
+  };
+  auto build_loops = [&](int f) {
+    FaceLoops fl;
     const TopoDS_Face face = TopoDS::Face(model.faces(f + 1).Oriented(TopAbs_FORWARD));
     const BRepAdaptor_Surface surface(face, false);
     const TopoDS_Wire outer = BRepTools::OuterWire(face);
-    std::vector<std::vector<BoundaryNode>> loops;
     std::size_t outer_loop = 0;
     for (TopExp_Explorer wires(face, TopAbs_WIRE); wires.More(); wires.Next()) {
       const TopoDS_Wire wire = TopoDS::Wire(wires.Current());
-      if (wire.IsSame(outer)) outer_loop = loops.size();
+      const bool is_outer = wire.IsSame(outer);
       std::vector<BoundaryNode> loop;
+      std::vector<std::array<int, 2>> seg;
       bool first_chain = true;
       Uv previous_end{0, 0}, loop_start{0, 0};
       for (BRepTools_WireExplorer we(wire, face); we.More(); we.Next()) {
@@ -231,7 +232,8 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
         }
         std::vector<double> t;
         std::vector<Index> ids;
-        if (edge_nodes[e].degenerated) {
+        const bool degenerated = edge_nodes[e].degenerated;
+        if (degenerated) {
           // A degenerated edge (a pole, an apex): several (u, v) nodes, one 3D node.
           const int segments = 8;
           for (int i = 0; i <= segments; ++i) {
@@ -242,7 +244,8 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
           t = edge_nodes[e].t;
           ids = edge_nodes[e].node;
         }
-        if (edge.Orientation() == TopAbs_REVERSED) {
+        const bool reversed = edge.Orientation() == TopAbs_REVERSED;
+        if (reversed) {
           std::reverse(t.begin(), t.end());
           std::reverse(ids.begin(), ids.end());
         }
@@ -258,39 +261,122 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
         }
         first_chain = false;
         previous_end = chain.back();
-        for (std::size_t i = 0; i + 1 < chain.size(); ++i) {
-          const Index id = ids[i];
+        const int n_seg = static_cast<int>(chain.size()) - 1;
+        for (int i = 0; i < n_seg; ++i) {
+          const Index id = ids[static_cast<std::size_t>(i)];
           const Vec3 p{out.xyz[3 * static_cast<std::size_t>(id)], out.xyz[3 * static_cast<std::size_t>(id) + 1],
                        out.xyz[3 * static_cast<std::size_t>(id) + 2]};
-          loop.push_back({chain[i], id, p});
+          loop.push_back({chain[static_cast<std::size_t>(i)], id, p});
+          seg.push_back({degenerated ? -1 : e, reversed ? n_seg - 1 - i : i});
         }
       }
       if (loop.size() < 2) continue;
-      // The loop must close in (u, v); a face on a periodic surface without a seam edge does not.
-      const double du = previous_end[0] - loop_start[0], dv = previous_end[1] - loop_start[1];
-      double u0, u1, v0, v1;
-      BRepTools::UVBounds(face, u0, u1, v0, v1);
-      const double scale = std::max(u1 - u0, v1 - v0);
-      if (std::hypot(du, dv) > 1e-6 * scale + 1e-9) {
-        std::ostringstream what;
-        what << "Face" << f + 1 << ": a boundary loop does not close in the face's parameters (a periodic face "
-                "without a seam edge?); FreeCAD's Part > Refine shape or Part > Check geometry may mend it";
-        input_error(model, what.str());
+      // The loop must close: real files leave gaps between consecutive pcurves within the
+      // vertices' tolerance (harmless: each chain starts at its own point); a face on a periodic
+      // surface without a seam edge closes only modulo the period, which this mesher cannot take.
+      for (int axis = 0; axis < 2; ++axis) {
+        const bool periodic = axis == 0 ? surface.IsUPeriodic() : surface.IsVPeriodic();
+        if (!periodic) continue;
+        const double period = axis == 0 ? surface.UPeriod() : surface.VPeriod();
+        if (std::abs(previous_end[axis] - loop_start[axis]) > 0.25 * period) {
+          std::ostringstream what;
+          what << "Face" << f + 1 << ": a boundary loop does not close in the face's parameters (a periodic face "
+                  "without a seam edge?); FreeCAD's Part > Refine shape or Part > Check geometry may mend it";
+          input_error(model, what.str());
+        }
       }
-      loops.push_back(std::move(loop));
+      if (is_outer) outer_loop = fl.loops.size();
+      fl.loops.push_back(std::move(loop));
+      fl.seg.push_back(std::move(seg));
     }
+    if (fl.loops.empty()) return fl;
+    std::swap(fl.loops[0], fl.loops[outer_loop]);
+    std::swap(fl.seg[0], fl.seg[outer_loop]);
+    // Material on the left: the outer loop counter-clockwise, holes clockwise. Reversing a loop
+    // moves each segment's name one place (segment i joined nodes i and i + 1).
+    auto reverse_loop = [&](std::size_t l) {
+      auto& loop = fl.loops[l];
+      auto& seg = fl.seg[l];
+      std::reverse(loop.begin(), loop.end());
+      std::reverse(seg.begin(), seg.end());
+      std::rotate(seg.begin(), seg.begin() + 1, seg.end());
+    };
+    if (loop_area(fl.loops[0]) < 0)
+      for (std::size_t l = 0; l < fl.loops.size(); ++l) reverse_loop(l);
+    for (std::size_t l = 1; l < fl.loops.size(); ++l)
+      if (loop_area(fl.loops[l]) > 0) reverse_loop(l);
+    return fl;
+  };
+
+  // ---- Boundaries made simple: where two segments of a face's loops cross or touch in (u, v)
+  // (chords of curved edges on a thin face), both edge segments are split at their parameter
+  // midpoint, for every face at once, until no face has such a pair. ----
+  const int n_faces = model.num_faces();
+  constexpr int kSimplePasses = 12;
+  for (int pass = 0;; ++pass) {
+    std::set<std::array<int, 2>> to_split;
+    for (int f = 0; f < n_faces; ++f) {
+      const FaceLoops fl = build_loops(f);
+      struct Seg {
+        Uv a, b;
+        double umin, umax;
+        std::size_t loop, index, size;
+      };
+      std::vector<Seg> segs;
+      for (std::size_t l = 0; l < fl.loops.size(); ++l) {
+        const auto& loop = fl.loops[l];
+        for (std::size_t i = 0; i < loop.size(); ++i) {
+          const Uv& a = loop[i].uv;
+          const Uv& b = loop[(i + 1) % loop.size()].uv;
+          segs.push_back({a, b, std::min(a[0], b[0]), std::max(a[0], b[0]), l, i, loop.size()});
+        }
+      }
+      std::sort(segs.begin(), segs.end(), [](const Seg& x, const Seg& y) { return x.umin < y.umin; });
+      for (std::size_t i = 0; i < segs.size(); ++i) {
+        for (std::size_t j = i + 1; j < segs.size() && segs[j].umin <= segs[i].umax; ++j) {
+          const Seg &x = segs[i], &y = segs[j];
+          if (x.loop == y.loop && ((x.index + 1) % x.size == y.index || (y.index + 1) % y.size == x.index)) continue;
+          if (!uv_segments_meet(x.a, x.b, y.a, y.b)) continue;
+          for (const Seg* z : {&x, &y}) {
+            const auto& name = fl.seg[z->loop][z->index];
+            if (name[0] >= 0) to_split.insert(name);
+          }
+        }
+      }
+    }
+    if (to_split.empty()) break;
+    if (pass == kSimplePasses) {
+      std::ostringstream what;
+      what << "the boundary of a face crosses itself in its parameter plane after " << kSimplePasses
+           << " refinements of Edge" << (*to_split.begin())[0] + 1 << "; check the part (FreeCAD's Part > Check geometry)";
+      input_error(model, what.str());
+    }
+    // Split from the last segment of each edge backwards, so earlier indices stay valid.
+    for (auto it = to_split.rbegin(); it != to_split.rend(); ++it) {
+      const int e = (*it)[0], j = (*it)[1];
+      EdgeNodes& en = edge_nodes[static_cast<std::size_t>(e)];
+      BRepAdaptor_Curve curve(TopoDS::Edge(model.edges(e + 1).Oriented(TopAbs_FORWARD)));
+      const double tm = 0.5 * (en.t[static_cast<std::size_t>(j)] + en.t[static_cast<std::size_t>(j) + 1]);
+      en.t.insert(en.t.begin() + j + 1, tm);
+      en.node.insert(en.node.begin() + j + 1, add_node(curve.Value(tm), 1, e));
+    }
+  }
+
+  // ---- Faces, each once. ----
+  std::vector<std::vector<std::array<Index, 3>>> face_tris(static_cast<std::size_t>(n_faces));
+  CadSurfaceStats st;
+  for (int f = 0; f < n_faces; ++f) {
+    check_cancel();
+    const TopoDS_Face face = TopoDS::Face(model.faces(f + 1).Oriented(TopAbs_FORWARD));
+    const BRepAdaptor_Surface surface(face, false);
+    std::vector<std::vector<BoundaryNode>> loops = build_loops(f).loops;
     if (loops.empty()) continue;
-    std::swap(loops[0], loops[outer_loop]);
-    // Material on the left: the outer loop counter-clockwise, holes clockwise.
-    if (loop_area(loops[0]) < 0)
-      for (auto& loop : loops) std::reverse(loop.begin(), loop.end());
-    for (std::size_t i = 1; i < loops.size(); ++i)
-      if (loop_area(loops[i]) > 0) std::reverse(loops[i].begin(), loops[i].end());
 
     FaceMeshOptions fo;
     fo.face_size = field.face_size(f);
     fo.min_size = field.min_size();
     fo.grading = field.grading();
+    if (field.face_has_local_curvature(f)) fo.local_curvature_points_per_circle = field.points_per_circle();
     fo.max_rounds = options.face_rounds;
     FaceMesh fm;
     try {
@@ -301,10 +387,6 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
       throw MeshingError(ErrorCode::kInternal, "cad_surface", f, model.source + ": " + what.str());
     }
     for (const Vec3& p : fm.new_xyz) add_node(gp_Pnt(p.x, p.y, p.z), 2, f);
-    if (std::getenv("BSPTET_FACE_DEBUG"))
-      std::fprintf(stderr, "Face%d type %d size %.4g loops %zu bnodes %zu tris %zu newnodes %zu minq %.3f folds %lld\n", f + 1,
-                   (int)surface.GetType(), fo.face_size, loops.size(), [&] { std::size_t n = 0; for (auto& l : loops) n += l.size(); return n; }(),
-                   fm.triangles.size(), fm.new_xyz.size(), fm.min_quality, (long long)fm.folds);
     st.folds += fm.folds;
     st.min_quality = std::min(st.min_quality, fm.min_quality);
     face_tris[f] = std::move(fm.triangles);

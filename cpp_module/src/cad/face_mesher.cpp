@@ -1,13 +1,13 @@
 // FemBspTet CAD layer: face meshing by local operations in the parameter plane (see face_mesher.h).
 #include "bsptet/cad/face_mesher.h"
 
+#include "bsptet/cad/size_field.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <utility>
-#include <cstdio>
-#include <cstdlib>
 
 #include <BRepAdaptor_Surface.hxx>
 #include <gp_Pnt.hxx>
@@ -95,9 +95,17 @@ class FaceMesher {
     }
     return shape * worst;
   }
-  bool positive_uv(int a, int b, int c) const { return uv_orient(verts_[a].uv, verts_[b].uv, verts_[c].uv) > 0; }
-  double size_at(const Vec3& p) const {
+  /// May (a, b, c) be made: counter-clockwise in (u, v) (exact), except at a pole, where the
+  /// corner's u is arbitrary and the parameter plane's orientation says nothing about the 3D
+  /// triangle: there the triangle must face the surface's way in 3D (quality > 0).
+  bool valid(int a, int b, int c) const {
+    if (verts_[a].pole || verts_[b].pole || verts_[c].pole) return quality(a, b, c) > 0;
+    return uv_orient(verts_[a].uv, verts_[b].uv, verts_[c].uv) > 0;
+  }
+  double size_at(const Uv& uv, const Vec3& p) const {
     double s = options_.face_size;
+    if (options_.local_curvature_points_per_circle > 0)
+      s = std::min(s, local_curvature_size(surface_, uv[0], uv[1], options_.local_curvature_points_per_circle));
     for (const auto& [b, sb] : boundary_sizes_) s = std::min(s, sb + options_.grading * dist(p, b));
     return std::max(s, options_.min_size);
   }
@@ -125,7 +133,7 @@ class FaceMesher {
     }
   }
   int add_vertex(const Uv& uv, const Vec3& xyz) {
-    verts_.push_back({uv, xyz, -1, false, false, size_at(xyz), normal(uv)});
+    verts_.push_back({uv, xyz, -1, false, false, size_at(uv, xyz), normal(uv)});
     vt_.emplace_back();
     return static_cast<int>(verts_.size()) - 1;
   }
@@ -159,7 +167,8 @@ class FaceMesher {
   }
 
   bool split(int a, int b);
-  bool flip(int a, int b);
+  bool flip(int a, int b, bool in_3d = false);
+  int untangle_pass();
   bool collapse(int v, int w);
   bool smooth(int v);
   int split_pass();
@@ -178,13 +187,15 @@ class FaceMesher {
 
 bool FaceMesher::split(int a, int b) {
   const auto [t0, t1] = edge_tris(a, b);
-  if (std::getenv("BSPTET_FACE_DEBUG2") && !verts_[b].boundary && verts_[a].uv[0] > 5.7 && verts_[a].uv[1] == 9 && std::abs(verts_[b].uv[0] - 1.571) < 0.01) std::fprintf(stderr, "split %d %d t %d %d\n", a, b, t0, t1);
   if (t0 < 0 || t1 < 0) return false;  // a boundary edge: never split
   const int c = opposite(tris_[static_cast<std::size_t>(t0)], a, b);
   const int d = opposite(tris_[static_cast<std::size_t>(t1)], a, b);
   const Uv uv = mid(verts_[a].uv, verts_[b].uv);
   const int m = add_vertex(uv, eval(uv));
-  if (!positive_uv(a, m, c) || !positive_uv(m, b, c) || !positive_uv(b, m, d) || !positive_uv(m, a, d)) {
+  // Splits are judged in (u, v) even at a pole: they refine big start triangles whose 3D shape
+  // is poor anyway, until (u, v) and 3D agree.
+  auto uv_ok = [&](int x, int y, int z) { return uv_orient(verts_[x].uv, verts_[y].uv, verts_[z].uv) > 0; };
+  if (!uv_ok(a, m, c) || !uv_ok(m, b, c) || !uv_ok(b, m, d) || !uv_ok(m, a, d)) {
     verts_.pop_back();
     vt_.pop_back();
     return false;
@@ -198,13 +209,21 @@ bool FaceMesher::split(int a, int b) {
   return true;
 }
 
-bool FaceMesher::flip(int a, int b) {
+bool FaceMesher::flip(int a, int b, bool in_3d) {
   const auto [t0, t1] = edge_tris(a, b);
   if (t0 < 0 || t1 < 0) return false;
   const int c = opposite(tris_[static_cast<std::size_t>(t0)], a, b);
   const int d = opposite(tris_[static_cast<std::size_t>(t1)], a, b);
   if (c == d || seam_pair(c, d)) return false;
-  if (!positive_uv(a, d, c) || !positive_uv(d, b, c)) return false;
+  if (in_3d) {
+    // The new edge must not exist already (in (u, v) it cannot; judged in 3D it could).
+    for (int t : vt_[static_cast<std::size_t>(c)])
+      for (int u : tris_[static_cast<std::size_t>(t)])
+        if (u == d) return false;
+    if (!(quality(a, d, c) > 0) || !(quality(d, b, c) > 0)) return false;
+  } else if (!valid(a, d, c) || !valid(d, b, c)) {
+    return false;
+  }
   const double before = std::min(quality(a, b, c), quality(b, a, d));
   const double after = std::min(quality(a, d, c), quality(d, b, c));
   // An edge joining two copies of one node across the face (a seam's two sides) always goes.
@@ -231,7 +250,7 @@ bool FaceMesher::collapse(int v, int w) {
     Tri y = x;
     for (int& u : y)
       if (u == v) u = w;
-    if (!positive_uv(y[0], y[1], y[2])) return false;
+    if (!valid(y[0], y[1], y[2])) return false;
     after = std::min(after, quality(y[0], y[1], y[2]));
     for (int u : y)
       if (u != w && edge_ratio(w, u) > kSplitRatio) return false;
@@ -276,14 +295,14 @@ bool FaceMesher::smooth(int v) {
     bool ok = true;
     for (int t : ring) {
       const Tri& x = tris_[static_cast<std::size_t>(t)];
-      if (!positive_uv(x[0], x[1], x[2])) {
+      if (!valid(x[0], x[1], x[2])) {
         ok = false;
         break;
       }
       after = std::min(after, quality(x[0], x[1], x[2]));
     }
     if (ok && after > before + 1e-9) {
-      verts_[v].size = size_at(verts_[v].xyz);
+      verts_[v].size = size_at(verts_[v].uv, verts_[v].xyz);
       return true;
     }
   }
@@ -298,12 +317,6 @@ int FaceMesher::split_pass() {
     if (r > kSplitRatio) candidates.push_back({r, {a, b}});
   }
   std::stable_sort(candidates.begin(), candidates.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-  if (std::getenv("BSPTET_FACE_DEBUG") && !candidates.empty()) {
-    for (int k = 0; k < 3 && k < (int)candidates.size(); ++k) {
-      auto [a, b] = candidates[k].second;
-      std::fprintf(stderr, "   cand r %.3g a(%.4g,%.4g s%.3g b%d) b(%.4g,%.4g s%.3g b%d) d %.4g\n", candidates[k].first, verts_[a].uv[0], verts_[a].uv[1], verts_[a].size, verts_[a].boundary, verts_[b].uv[0], verts_[b].uv[1], verts_[b].size, verts_[b].boundary, dist(verts_[a].xyz, verts_[b].xyz));
-    }
-  }
   int done = 0;
   for (const auto& [r, e] : candidates) {
     // A split edge's neighbours may have been split already; the edge is then gone or shorter.
@@ -334,9 +347,29 @@ int FaceMesher::collapse_pass() {
 
 int FaceMesher::flip_pass() {
   int total = 0;
-  for (int sweep = 0; sweep < 8; ++sweep) {
+  for (int sweep = 0; sweep < 32; ++sweep) {
     int done = 0;
     for (const auto& [a, b] : interior_edges()) done += flip(a, b) ? 1 : 0;
+    total += done;
+    if (done == 0) break;
+  }
+  return total;
+}
+
+/// Triangles that still face against the surface (a fold: the start's ear-cut triangles near a
+/// pole or across a strongly curved patch) are flipped away judged in 3D alone: both new
+/// triangles must face the surface's way.
+int FaceMesher::untangle_pass() {
+  int total = 0;
+  for (int sweep = 0; sweep < 8; ++sweep) {
+    int done = 0;
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      if (!alive_[t]) continue;
+      const Tri x = tris_[t];
+      if (quality(x[0], x[1], x[2]) > 0) continue;
+      for (int i = 0; i < 3 && alive_[t]; ++i)
+        if (flip(x[i], x[(i + 1) % 3], /*in_3d=*/true)) ++done;
+    }
     total += done;
     if (done == 0) break;
   }
@@ -378,6 +411,7 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
   }
   for (const auto& t : triangulate_polygon(uv, index_loops)) add_tri({t[0], t[1], t[2]});
 
+  flip_pass();  // the ear-cut fan into a better-shaped start: splits then spread points evenly
   for (int round = 0; round < options_.max_rounds; ++round) {
     const int splits = split_pass();
     flip_pass();
@@ -385,13 +419,10 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
     flip_pass();
     smooth_pass();
     flip_pass();
-    if (std::getenv("BSPTET_FACE_DEBUG")) {
-      int alive = 0; for (char a : alive_) alive += a;
-      std::fprintf(stderr, "  round %d splits %d collapses %d tris %d\n", round, splits, collapses, alive);
-    }
     if (splits == 0 && collapses == 0) break;
   }
   for (int round = 0; round < 3; ++round) {
+    untangle_pass();
     const int moved = smooth_pass();
     const int flipped = flip_pass();
     if (moved == 0 && flipped == 0) break;

@@ -30,9 +30,8 @@ void check_option(double value, const char* name) {
   }
 }
 
-/// Largest principal curvature of the face, sampled on a grid over its parameter bounds
-/// (analytic surfaces: their radius directly).
-double max_face_curvature(const TopoDS_Face& face) {
+/// Largest principal curvature of an analytic face (its smallest radius); -1 for other surfaces.
+double analytic_face_curvature(const TopoDS_Face& face) {
   BRepAdaptor_Surface surface(face, /*restriction=*/true);
   switch (surface.GetType()) {
     case GeomAbs_Plane:
@@ -44,23 +43,8 @@ double max_face_curvature(const TopoDS_Face& face) {
     case GeomAbs_Torus:
       return 1.0 / surface.Torus().MinorRadius();
     default:
-      break;
+      return -1;
   }
-  double u0, u1, v0, v1;
-  BRepTools::UVBounds(face, u0, u1, v0, v1);
-  constexpr int kSamples = 12;
-  BRepLProp_SLProps props(surface, 2, 1e-9);
-  double kmax = 0;
-  for (int i = 0; i <= kSamples; ++i) {
-    for (int j = 0; j <= kSamples; ++j) {
-      const double u = u0 + (u1 - u0) * i / kSamples, v = v0 + (v1 - v0) * j / kSamples;
-      props.SetParameters(u, v);
-      if (!props.IsCurvatureDefined()) continue;
-      const double k = std::max(std::abs(props.MaxCurvature()), std::abs(props.MinCurvature()));
-      if (std::isfinite(k)) kmax = std::max(kmax, k);
-    }
-  }
-  return kmax;
 }
 
 }  // namespace
@@ -76,16 +60,26 @@ SizeField::SizeField(const CadModel& model, const SizeOptions& options) {
   grading_ = options.grading > 0 ? options.grading : 0.3;
   points_per_circle_ = options.points_per_circle;
   face_size_.assign(static_cast<std::size_t>(model.num_faces()), size_);
+  local_curvature_.assign(static_cast<std::size_t>(model.num_faces()), 0);
   for (int f = 0; f < model.num_faces(); ++f) {
     double s = size_;
     const auto it = options.size_by_face.find(f);
     if (it != options.size_by_face.end() && it->second > 0) s = std::min(s, it->second);
     if (points_per_circle_ > 0) {
-      const double k = max_face_curvature(TopoDS::Face(model.faces(f + 1)));
+      const double k = analytic_face_curvature(TopoDS::Face(model.faces(f + 1)));
       if (k > 0) s = std::min(s, kTwoPi / (k * points_per_circle_));
+      local_curvature_[static_cast<std::size_t>(f)] = k < 0;
     }
     face_size_[static_cast<std::size_t>(f)] = clamp(s);
   }
+}
+
+double local_curvature_size(const BRepAdaptor_Surface& surface, double u, double v, double points_per_circle) {
+  if (points_per_circle <= 0) return kInf;
+  BRepLProp_SLProps props(surface, u, v, 2, 1e-9);
+  if (!props.IsCurvatureDefined()) return kInf;
+  const double k = std::max(std::abs(props.MaxCurvature()), std::abs(props.MinCurvature()));
+  return k > 0 && std::isfinite(k) ? kTwoPi / (k * points_per_circle) : kInf;
 }
 
 double SizeField::clamp(double s) const { return std::max(min_size_, std::min(size_, s)); }

@@ -10,21 +10,6 @@
 namespace bsptet::cad {
 namespace {
 
-/// Closed segment intersection (touching counts), exact.
-bool segments_meet(const Uv& a, const Uv& b, const Uv& c, const Uv& d) {
-  const int o1 = uv_orient(a, b, c), o2 = uv_orient(a, b, d), o3 = uv_orient(c, d, a), o4 = uv_orient(c, d, b);
-  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
-  auto on = [](const Uv& p, const Uv& q, const Uv& r) {  // r on segment pq, given collinear
-    return std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) && std::min(p[1], q[1]) <= r[1] &&
-           r[1] <= std::max(p[1], q[1]);
-  };
-  if (o1 == 0 && on(a, b, c)) return true;
-  if (o2 == 0 && on(a, b, d)) return true;
-  if (o3 == 0 && on(c, d, a)) return true;
-  if (o4 == 0 && on(c, d, b)) return true;
-  return false;
-}
-
 /// Whether the direction from sequence position k towards point h leaves into the polygon's interior
 /// (the interior is left of the counter-clockwise boundary).
 bool enters_interior(const std::vector<Uv>& uv, const std::vector<int>& seq, std::size_t k, int h) {
@@ -61,7 +46,7 @@ void bridge_hole(const std::vector<Uv>& uv, std::vector<int>& outer, const std::
     for (std::size_t i = 0; i < n; ++i) {
       const int e0 = loop[i], e1 = loop[(i + 1) % n];
       if (e0 == p || e1 == p || e0 == h || e1 == h) continue;
-      if (segments_meet(uv[static_cast<std::size_t>(e0)], uv[static_cast<std::size_t>(e1)], hp,
+      if (uv_segments_meet(uv[static_cast<std::size_t>(e0)], uv[static_cast<std::size_t>(e1)], hp,
                         uv[static_cast<std::size_t>(p)]))
         return true;
     }
@@ -84,6 +69,20 @@ void bridge_hole(const std::vector<Uv>& uv, std::vector<int>& outer, const std::
 }
 
 }  // namespace
+
+bool uv_segments_meet(const Uv& a, const Uv& b, const Uv& c, const Uv& d) {
+  const int o1 = uv_orient(a, b, c), o2 = uv_orient(a, b, d), o3 = uv_orient(c, d, a), o4 = uv_orient(c, d, b);
+  if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+  auto on = [](const Uv& p, const Uv& q, const Uv& r) {  // r on segment pq, given collinear
+    return std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) && std::min(p[1], q[1]) <= r[1] &&
+           r[1] <= std::max(p[1], q[1]);
+  };
+  if (o1 == 0 && on(a, b, c)) return true;
+  if (o2 == 0 && on(a, b, d)) return true;
+  if (o3 == 0 && on(c, d, a)) return true;
+  if (o4 == 0 && on(c, d, b)) return true;
+  return false;
+}
 
 int uv_orient(const Uv& a, const Uv& b, const Uv& c) {
   return to_int(orient2d_projected(Vec3{a[0], a[1], 0}, Vec3{b[0], b[1], 0}, Vec3{c[0], c[1], 0}, 2));

@@ -8,9 +8,14 @@
 // (face_mesher.h), then each solid's closed surface from its faces. A face shared by two solids
 // of a CompSolid is meshed once and used by both, reversed in one: the solids' meshes conform.
 //
+// Before any face is meshed, every face's boundary loops are made simple in its parameter
+// plane: where two boundary segments cross or touch (chords of curved edges on a thin face),
+// both edge segments are split at their parameter midpoint, on every face at once (the edges are
+// shared), until none does.
+//
 // Nodes: the CAD vertices first (CAD vertex order, at BRep_Tool::Pnt), then the interior nodes of
-// each edge (edge order, on its 3D curve), then each face's interior nodes (face order, on its
-// surface). Every node is evaluated on its CAD entity by OpenCASCADE; node_dim / node_entity say
+// each edge (edge order, on its 3D curve; nodes added to make boundaries simple follow, in the
+// order of those passes), then each face's interior nodes (face order, on its surface). Every node is evaluated on its CAD entity by OpenCASCADE; node_dim / node_entity say
 // which. Triangles are tagged with their CAD face index (0-based, FreeCAD's Face<k+1>) and
 // oriented outward of their solid (counter-clockwise seen from outside, as types.h says).
 #pragma once

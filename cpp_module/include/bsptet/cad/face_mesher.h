@@ -5,17 +5,30 @@
 // Method (in the face's parameter plane, lengths and shapes measured in 3D on the surface, as
 // Gmsh's MeshAdapt does):
 //  1. the boundary loops (the nodes of the face's edges, at their pcurve parameters) are
-//     triangulated in (u, v) by ear cutting (uv_polygon.h);
-//  2. rounds of local operations, each kept only when every triangle it makes turns
-//     counter-clockwise in (u, v) (exact orient2d): interior edges longer than 1.4 times the local
-//     size are split at their (u, v) midpoint (the new node evaluated on the surface), edges
-//     shorter than 0.7 times it are collapsed onto a neighbour (interior nodes only), edges are
-//     flipped when that raises the smaller shape quality of their two triangles, and interior
-//     nodes move towards the mean of their neighbours when that raises the worst quality around
-//     them. Shape quality is 4 sqrt(3) area / (sum of squared edge lengths) in 3D, 1 for an
-//     equilateral triangle, negative when the triangle's normal opposes the surface's (a fold).
+//     triangulated in (u, v) by ear cutting (uv_polygon.h), and that fan is flipped towards
+//     better shapes;
+//  2. rounds of local operations, each kept only when every triangle it makes is valid (below):
+//     interior edges longer than 1.4 times the local size are split at their (u, v) midpoint
+//     (the new node evaluated on the surface), edges shorter than 0.7 times it are collapsed onto
+//     a neighbour (interior nodes only), edges are flipped when that raises the smaller quality
+//     of their two triangles, and interior nodes move towards the mean of their neighbours when
+//     that raises the worst quality around them;
+//  3. triangles still facing against the surface are flipped away judged in 3D alone.
+// Quality: 4 sqrt(3) area / (sum of squared edge lengths) in 3D (1 for an equilateral
+// triangle) times the smallest cosine between the triangle's normal and the surface normal at
+// its corners: a chord across a wide arc scores low however equilateral, and a triangle facing
+// against the surface (a fold) scores negative. Valid: counter-clockwise in (u, v) (exact
+// orient2d); a triangle with a corner on a pole is judged in 3D instead (quality > 0), since a
+// pole's (u, v) copies are one point. The local size is the face's size, the local curvature
+// size on non-analytic surfaces (size_field.h), and the boundary spacing grown by `grading`.
 // Boundary nodes never move. Nodes of a degenerated edge (a cone apex, a sphere pole) share one
-// node id: triangles with two such corners are zero-area in 3D and are dropped at the end.
+// node id: triangles with two such corners are zero-area in 3D and are dropped at the end. Two
+// copies of one seam node (u = 0 and u = period) must never share a triangle: such edges are
+// split or flipped away.
+//
+// Known limits: near a pole or a cone apex, and on strongly twisted B-spline patches, a few
+// triangles may stay folded (FaceMesh::folds counts them); the volume stage then refuses the
+// surface, naming the crossing triangles.
 //
 // Orientation: triangles turn counter-clockwise in (u, v) of the FORWARD face, so their right-hand
 // normal is the surface's S_u x S_v; the caller reverses them for a face REVERSED in its solid.
@@ -42,6 +55,8 @@ struct FaceMeshOptions {
   double face_size = 1;    ///< the face's size (SizeField::face_size)
   double min_size = 0;     ///< never split edges shorter than 2 * min_size
   double grading = 0.3;    ///< growth of the size away from the boundary nodes, per unit length
+  /// > 0: the size at a node is also at most the local curvature size there (size_field.h)
+  double local_curvature_points_per_circle = 0;
   int max_rounds = 20;     ///< rounds of split / collapse / flip / smooth at most
 };
 

@@ -4,8 +4,11 @@
 //  * `size`, the largest element size (FreeCAD's / Gmsh's CharacteristicLengthMax);
 //  * the size asked for the CAD face (`size_by_face`), on that face and its edges;
 //  * curvature: 2 pi R / points_per_circle where R is the smallest radius of curvature (a circle
-//    of radius R gets points_per_circle segments; on a face, the largest principal curvature
-//    sampled over the face; on an edge, the curve's curvature at that parameter);
+//    of radius R gets points_per_circle segments): on a plane, cylinder, cone, sphere or torus
+//    face, its smallest radius, over the whole face; on any other surface (B-spline, revolution,
+//    offset...), the largest principal curvature at the point itself (local_curvature_size),
+//    so that one tight spot does not fine the whole face; on an edge, the curve's curvature at
+//    that parameter;
 //  * gradation: sizes grow away from smaller ones by at most `grading` per unit length (along an
 //    edge from its vertices, inside a face from its boundary nodes);
 // and never below `min_size` (CharacteristicLengthMin). Lengths in model units.
@@ -17,6 +20,7 @@
 #include "bsptet/cad/cad_model.h"
 
 class BRepAdaptor_Curve;
+class BRepAdaptor_Surface;
 
 namespace bsptet::cad {
 
@@ -44,6 +48,10 @@ class SizeField {
   double grading() const { return grading_; }
   /// The size on face f (0-based): h, its size_by_face and its curvature size, at least min_size.
   double face_size(int f) const { return face_size_[static_cast<std::size_t>(f)]; }
+  /// True when face f's curvature size varies over it (not an analytic surface): the face mesher
+  /// then asks local_curvature_size at each node.
+  bool face_has_local_curvature(int f) const { return local_curvature_[static_cast<std::size_t>(f)] != 0; }
+  double points_per_circle() const { return points_per_circle_; }
   /// The curvature size of `curve` at parameter t (infinity on a straight piece or when off).
   double curve_curvature_size(const BRepAdaptor_Curve& curve, double t) const;
   /// Clamps a size to [min_size, size].
@@ -52,6 +60,11 @@ class SizeField {
  private:
   double size_ = 0, min_size_ = 0, grading_ = 0.3, points_per_circle_ = 12;
   std::vector<double> face_size_;
+  std::vector<char> local_curvature_;
 };
+
+/// 2 pi / (k points_per_circle) for the largest principal curvature k of `surface` at (u, v);
+/// infinity where the curvature is zero or undefined (a singular point) or points_per_circle is 0.
+double local_curvature_size(const BRepAdaptor_Surface& surface, double u, double v, double points_per_circle);
 
 }  // namespace bsptet::cad

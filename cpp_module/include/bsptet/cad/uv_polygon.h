@@ -25,4 +25,7 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Uv>& uv, c
 /// Exact sign of the turn a -> b -> c in the (u, v) plane: +1 counter-clockwise, -1 clockwise, 0 collinear.
 int uv_orient(const Uv& a, const Uv& b, const Uv& c);
 
+/// Whether the closed segments ab and cd share a point (crossing or touching), exact.
+bool uv_segments_meet(const Uv& a, const Uv& b, const Uv& c, const Uv& d);
+
 }  // namespace bsptet::cad
