@@ -499,7 +499,7 @@ class Refiner {
         }
         x[3 * (4 + e)] = mid.x, x[3 * (4 + e) + 1] = mid.y, x[3 * (4 + e) + 2] = mid.z;
       }
-      return !curved || tet10_min_jacobian(x) > 0;
+      return !curved || certify_tet10(x) == Tet10Validity::kCertified;
     };
     auto corners = [&](const std::array<Index, 4>& q) {
       return std::array<Vec3, 4>{m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3])};

@@ -14,41 +14,7 @@ namespace {
 // Local corner pairs of the six mid-nodes, in types.h order: m12 m23 m31 m14 m24 m34.
 constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 
-int mid_slot(int i, int j) {
-  for (int e = 0; e < 6; ++e)
-    if ((kEdge[e][0] == i && kEdge[e][1] == j) || (kEdge[e][0] == j && kEdge[e][1] == i)) return 4 + e;
-  return -1;
-}
-
-double jacobian_at(const double* x, const double L[4]) {
-  // d x / d L_k = (4 L_k - 1) x_k + sum_{j != k} 4 L_j m_kj; r, s, t = L1, L2, L3, L0 = 1 - r - s - t.
-  double dL[4][3];
-  for (int k = 0; k < 4; ++k)
-    for (int c = 0; c < 3; ++c) {
-      double v = (4 * L[k] - 1) * x[3 * k + c];
-      for (int j = 0; j < 4; ++j)
-        if (j != k) v += 4 * L[j] * x[3 * mid_slot(k, j) + c];
-      dL[k][c] = v;
-    }
-  double J[3][3];
-  for (int a = 0; a < 3; ++a)
-    for (int c = 0; c < 3; ++c) J[a][c] = dL[a + 1][c] - dL[0][c];
-  return J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
-         J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
-}
-
 }  // namespace
-
-double tet10_min_jacobian(const double* xyz30) {
-  static const double kSamples[15][4] = {
-      {1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1},
-      {.5, .5, 0, 0}, {0, .5, .5, 0}, {.5, 0, .5, 0}, {.5, 0, 0, .5}, {0, .5, 0, .5}, {0, 0, .5, .5},
-      {1. / 3, 1. / 3, 1. / 3, 0}, {1. / 3, 1. / 3, 0, 1. / 3}, {1. / 3, 0, 1. / 3, 1. / 3}, {0, 1. / 3, 1. / 3, 1. / 3},
-      {.25, .25, .25, .25}};
-  double best = INFINITY;
-  for (const auto& s : kSamples) best = std::min(best, jacobian_at(xyz30, s));
-  return best;
-}
 
 TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats* stats) {
   std::vector<Index> renum;
@@ -121,14 +87,26 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
       out.tet[static_cast<std::size_t>(10 * t + 4 + e)] =
           np + edge_id(lin.tet[static_cast<std::size_t>(4 * t + kEdge[e][0])], lin.tet[static_cast<std::size_t>(4 * t + kEdge[e][1])]);
   }
-  // Straighten the mid-nodes of curved tets that are not valid, until all are.
+  // Straighten the mid-nodes of curved tets that are not certified valid, until all are. Tets
+  // without a curved mid-node are not checked: nothing here could change them (they are the
+  // linear tet up to the rounding of their midpoints).
+  auto has_curved = [&](Index t) {
+    for (int e = 0; e < 6; ++e)
+      if (curved[static_cast<std::size_t>(out.tet[static_cast<std::size_t>(10 * t + 4 + e)] - np)]) return true;
+    return false;
+  };
+  std::vector<Index> to_check;
+  for (Index t = 0; t < nk; ++t)
+    if (has_curved(t)) to_check.push_back(t);
   for (bool changed = true; changed;) {
     changed = false;
-    for (Index t = 0; t < nk; ++t) {
+    for (Index t : to_check) {
+      if (!has_curved(t)) continue;
       double x[30];
       for (int k = 0; k < 10; ++k)
         for (int c = 0; c < 3; ++c) x[3 * k + c] = out.xyz[static_cast<std::size_t>(3 * out.tet[static_cast<std::size_t>(10 * t + k)] + c)];
-      if (tet10_min_jacobian(x) > 0) continue;
+      if (certify_tet10(x) == Tet10Validity::kCertified) continue;
+      ++st.not_certified;
       for (int e = 0; e < 6; ++e) {
         const std::size_t id = static_cast<std::size_t>(out.tet[static_cast<std::size_t>(10 * t + 4 + e)] - np);
         if (!curved[id]) continue;
@@ -142,6 +120,8 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
       }
     }
   }
+  st.curved_tets = 0;
+  for (Index t : to_check) st.curved_tets += has_curved(t);
   st.midnodes = static_cast<std::int64_t>(edges.size());
   if (stats) *stats = st;
   return out;

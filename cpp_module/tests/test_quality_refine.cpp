@@ -1,5 +1,5 @@
 // The quality stage: RefineMesh's local operations on hand-made meshes (each checked exactly, each
-// refused when invalid), the driver on real data, and the tet10 Jacobian.
+// refused when invalid) and the driver on real data (tet10 validity: test_tet10_certify.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,7 +17,6 @@
 #include "bsptet/predicates.h"
 #include "bsptet/quality_refine.h"
 #include "bsptet/refine_mesh.h"
-#include "bsptet/tet10.h"
 #include "bsptet/wall_thickness.h"
 
 using namespace bsptet;
@@ -349,20 +348,6 @@ TEST(QualityRefine, BadOptionsAreInputErrors) {
   o.size = 1;
   o.order = 3;
   EXPECT_THROW(refine_quality(s, core, o), InputError);
-}
-
-TEST(Tet10, StraightTetJacobianIsSixTimesItsVolume) {
-  const double v[4][3] = {{0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0, 5}};  // volume 5
-  double x[30];
-  for (int k = 0; k < 4; ++k)
-    for (int c = 0; c < 3; ++c) x[3 * k + c] = v[k][c];
-  const int e[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
-  for (int i = 0; i < 6; ++i)
-    for (int c = 0; c < 3; ++c) x[3 * (4 + i) + c] = 0.5 * (v[e[i][0]][c] + v[e[i][1]][c]);
-  EXPECT_DOUBLE_EQ(tet10_min_jacobian(x), 30.0);
-  // Pulling mid-node m12 across the opposite face makes the element invalid.
-  x[3 * 4 + 0] = -20;
-  EXPECT_LT(tet10_min_jacobian(x), 0);
 }
 
 // A 12-gon prism (a faceted cylinder of radius 10, height 30): side triangles tag 0, top tag 1,
