@@ -303,6 +303,9 @@ class Refiner {
       case SplitOutcome::kBadProjection:
         ++st_.projection_rejected;
         return false;
+      case SplitOutcome::kFixedSurface:
+        ++st_.splits_fixed_surface;
+        return false;
       case SplitOutcome::kNoEdge:
         return false;
     }
@@ -1143,12 +1146,22 @@ class Refiner {
 }  // namespace
 
 TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const RefineOptions& options,
-                       RefineStats* stats) {
+                       RefineStats* stats, SurfaceMesh* boundary) {
   const auto start = std::chrono::steady_clock::now();
   check_options(options);
   RefineStats st;
   RefineMesh m(surface, mesh, options.projection, options.surface_points);
+  m.set_fixed_tags(options.fixed_tags);
   Refiner(m, options, st).run();
+  if (boundary) {
+    std::vector<Index> old_to_new;
+    m.to_tet_mesh(&old_to_new);  // the numbering of the result (make_second_order's corners too)
+    *boundary = SurfaceMesh{};
+    for (const auto& [face, parent] : m.boundary_faces()) {
+      for (Index v : face) boundary->tri.push_back(old_to_new[static_cast<std::size_t>(v)]);
+      boundary->tag.push_back(m.tag_of(parent));
+    }
+  }
   TetMesh out;
   if (options.order == 2) {
     SecondOrderStats so;

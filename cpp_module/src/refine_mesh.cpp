@@ -324,11 +324,21 @@ std::vector<std::array<Index, 2>> RefineMesh::edges() const {
   return out;
 }
 
+void RefineMesh::set_fixed_tags(std::vector<std::int32_t> tags) {
+  std::sort(tags.begin(), tags.end());
+  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  fixed_tags_ = std::move(tags);
+}
+
 SplitOutcome RefineMesh::split_edge(Index u, Index v, double min_quality, Index* new_point) {
   const std::vector<Index> shell = tets_around_edge(u, v);
   if (shell.empty()) return SplitOutcome::kNoEdge;
   Index ta = -1, tb = -1;
   const EdgeKind kind = edge_kind(u, v, &ta, &tb);
+  if (kind != EdgeKind::kInterior && !fixed_tags_.empty() &&
+      (std::binary_search(fixed_tags_.begin(), fixed_tags_.end(), tag_of(ta)) ||
+       std::binary_search(fixed_tags_.begin(), fixed_tags_.end(), tag_of(tb))))
+    return SplitOutcome::kFixedSurface;
   const Vec3 pu = point(u), pv = point(v);
   const Vec3 mid{0.5 * (pu.x + pv.x), 0.5 * (pu.y + pv.y), 0.5 * (pu.z + pv.z)};
 
@@ -605,6 +615,7 @@ bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAc
   if (n < 2 || n > max_ring) return false;
   Index parent = -1;
   if (edge_kind(u, v, &parent) != EdgeKind::kInFace) return false;
+  if (std::binary_search(fixed_tags_.begin(), fixed_tags_.end(), tag_of(parent))) return false;
   std::vector<std::pair<Index, Index>> links;
   if (!shell_links(u, v, shell, links)) return false;
   // The open chain a = w_0 .. w_n = b: it starts at the link whose tail no link ends at.

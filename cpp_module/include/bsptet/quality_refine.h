@@ -40,6 +40,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "bsptet/refine_mesh.h"
 #include "bsptet/types.h"
@@ -97,6 +98,11 @@ struct RefineOptions {
   /// edge between two such corners that is not an edge of a boundary face of tag T (an interior
   /// edge, or an edge of another tag's face: the new point lies off T). Only with face tags.
   bool separate_face_tags = false;
+  /// Face tags whose input triangles are kept as they are: no point is put on a boundary edge of
+  /// a triangle with one of these tags (RefineMesh::set_fixed_tags). A face two solids share,
+  /// each solid refined by its own call, stays conforming so. Tet10 mid-nodes on those faces are
+  /// still placed by the hook.
+  std::vector<std::int32_t> fixed_tags;
   /// 1: linear tets; 2: 10-node tets (tet10.h).
   int order = 1;
   int max_passes = 40;       ///< size passes at most
@@ -120,6 +126,7 @@ struct RefineStats {
   std::int64_t splits_no_exact_point = 0;  ///< surface edges left long: no double exactly on them
   std::int64_t splits_rejected = 0;      ///< splits refused (a new tet not positive)
   std::int64_t projection_rejected = 0;  ///< hook results refused (non-finite)
+  std::int64_t splits_fixed_surface = 0;  ///< surface edges left: their face tag is fixed
   std::int64_t collapses = 0, flips23 = 0, flips32 = 0, relocations = 0;
   /// Of `collapses`: Steiner corners of near-flat tets collapsed whatever their edge lengths.
   std::int64_t flat_collapses = 0;
@@ -143,7 +150,10 @@ struct RefineStats {
 
 /// Refines and optimizes `mesh`, a valid linear tet mesh of `surface`. Throws InputError for bad
 /// options (naming the option), MeshingError otherwise (code kCancelled when cancelled).
+/// `boundary` (optional) receives the result's boundary faces (faces of one tet), oriented outward,
+/// as corner indices of the result, each with the tag of the input triangle it lies on (-1 when
+/// the surface has no tags), in the order of their sorted corners; its `xyz` is left empty.
 TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const RefineOptions& options,
-                       RefineStats* stats = nullptr);
+                       RefineStats* stats = nullptr, SurfaceMesh* boundary = nullptr);
 
 }  // namespace bsptet

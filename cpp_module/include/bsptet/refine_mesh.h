@@ -69,7 +69,8 @@ enum class SplitOutcome {
   kNoEdge,        ///< (u, v) is not an edge of the mesh
   kNoExactPoint,  ///< exact mode: no candidate double lies exactly on the boundary edge's support
   kInverted,      ///< every candidate point made some new tet non-positive
-  kBadProjection  ///< the projection hook returned a non-finite point
+  kBadProjection,  ///< the projection hook returned a non-finite point
+  kFixedSurface    ///< a boundary edge on a triangle whose tag is fixed (RefineMesh::set_fixed_tags)
 };
 
 /// What became of an interior point insertion (RefineMesh::insert_point).
@@ -133,6 +134,14 @@ class RefineMesh {
   std::int32_t tag_of(Index tri) const;
   /// The input surface the mesh refines.
   const SurfaceMesh& surface() const { return surface_; }
+
+  /// Face tags whose input triangulation is kept: split_edge refuses (kFixedSurface) every boundary
+  /// edge with a parent triangle of one of these tags, inside such a face or on its border, and
+  /// flip_boundary_edge refuses the edges inside such a face. No other operation changes boundary
+  /// faces there (insertions and relocations are interior, collapses move only points that are
+  /// not input points, and a fixed face has none), so its boundary faces stay the input triangles. This is what keeps a face shared by two solids
+  /// conforming when each solid is refined on its own.
+  void set_fixed_tags(std::vector<std::int32_t> tags);
 
   // ---- Operations: each checked exactly, applied only when valid --------------------------------
   /// Splits edge (u, v) at a point near its midpoint (see the file comment for the surface rules).
@@ -254,6 +263,7 @@ class RefineMesh {
 
   const SurfaceMesh& surface_;
   ProjectionHook hook_;
+  std::vector<std::int32_t> fixed_tags_;  ///< sorted
   SurfacePoints surface_points_;
   std::vector<Vec3> xyz_;
   std::vector<PointSupport> support_;

@@ -1,0 +1,137 @@
+// FemBspTet FEM pipeline: a CAD model to a tetrahedral FEM mesh, one entry point.
+//
+//   FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats)
+//
+// Stages, in order:
+//  1. surface: every CAD edge, then every CAD face meshed once at the size field
+//     (cad/cad_surface.h); each solid's closed surface from its faces;
+//  2. core, per solid: the exact tetrahedralization of that surface (mesher.h
+//     check_and_tetrahedralize: the surface is checked, self-intersections included, beside the
+//     core; no point is added on the surface);
+//  3. refine, per solid: quality_refine.h at the size field's h, sizes extended from the surface
+//     triangles (size_from_surface), new surface points and tet10 boundary mid-nodes put onto the
+//     CAD faces and edges by the projection hook (cad/cad_projection.h);
+//  4. merge: the solids' meshes in one node numbering. The CAD surface nodes are global (a face
+//     shared by two solids of a CompSolid, or a compound made conformal by a general fuse, is
+//     meshed once), so the solids' corner nodes coincide there.
+//
+// Faces shared by two solids: their surface is not refined (RefineOptions::fixed_tags: no point
+// is added on such a face or on its border), so both solids keep the same triangles there and the
+// merged mesh conforms. Their tet10 mid-nodes are projected by each solid; a mid-node the two
+// solids placed differently (one solid had to put it back on its chord to keep its curved tets
+// valid) is put on the chord for both, and any curved tet that this makes invalid gets all its
+// mid-nodes on their chords, until every tet is certified valid (tet10.h certify_tet10).
+// Solids that touch only along a CAD edge or at a CAD vertex share the CAD nodes there, but the
+// refinement of one solid may add points on such an edge that the other does not have: the merged
+// mesh is then not node-conforming along that edge (it is along shared faces).
+// Solids that overlap (a compound not made conformal) give overlapping tets; nothing checks that.
+//
+// Output node order: the CAD surface nodes (cad_surface.h order, unused ones dropped), then each
+// solid's added corner nodes (solid order, then the refinement's order), then the mid-nodes of an
+// order-2 mesh in the order their edges are first met (solid order, tet order, edge order m12 m23
+// m31 m14 m24 m34). Deterministic: no step depends on timing or addresses.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bsptet/cad/cad_model.h"
+#include "bsptet/cad/cad_projection.h"
+#include "bsptet/types.h"
+
+namespace bsptet::fem {
+
+/// The options a FreeCAD user sets (FreeCAD's mesher properties), with their units.
+struct FemOptions {
+  /// Largest element size h, model units (FreeCAD's CharacteristicLengthMax). 0: automatic, the
+  /// bounding-box diagonal / 20; curvature lowers it further (points_per_circle).
+  double size = 0;
+  /// Smallest element size, model units (CharacteristicLengthMin). 0: size / 50.
+  double min_size = 0;
+  /// Size on given CAD faces (0-based index: FreeCAD's Face<k+1>), model units.
+  std::map<int, double> size_by_face;
+  /// Curved faces and edges get at most 2 pi R / points_per_circle (R the radius of curvature);
+  /// 0 turns curvature sizing off.
+  double points_per_circle = 12;
+  /// How fast sizes grow away from smaller ones, per unit length, on the surface and in the volume
+  /// (Netgen's "moderate" is 0.3).
+  double grading = 0.3;
+  /// 1: 4-node tets (CalculiX C3D4); 2: 10-node tets (C3D10) whose boundary mid-nodes lie on the
+  /// CAD faces and edges.
+  int order = 2;
+  /// Optimization rounds of the quality stage at most (quality_refine.h).
+  int optimize_rounds = 8;
+  /// Rounds of local operations per CAD face at most (cad/face_mesher.h).
+  int face_rounds = 20;
+  /// Called with (stage, fraction of the whole run in [0, 1]); may be empty.
+  std::function<void(const std::string&, double)> progress;
+  /// Polled between steps; return true to stop (throws MeshingError with code kCancelled).
+  std::function<bool()> cancelled;
+};
+
+struct FemStats {
+  std::int64_t solids = 0, faces = 0;
+  double size = 0, min_size = 0;  ///< the size field's h and floor (automatic ones resolved)
+  // Surface (stage 1).
+  std::int64_t surface_nodes = 0, surface_triangles = 0;
+  std::int64_t shared_faces = 0;  ///< CAD faces bounding two solids (kept as meshed, see above)
+  // Core (stage 2), summed over the solids.
+  std::int64_t core_points = 0, core_tets = 0, core_steiner_points = 0;
+  // Refinement (stage 3), summed over the solids.
+  std::int64_t surface_splits = 0;        ///< points added on the surface (projected onto the CAD)
+  std::int64_t splits_fixed_surface = 0;  ///< surface edges left on shared faces
+  std::int64_t projection_refused = 0;    ///< hook answers the quality stage refused (see cad_projection.h)
+  std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2, per solid (tet10.h)
+  std::int64_t curving_conflicts_left = 0;  ///< order 2: tets the refinement left invalid when curved
+  // Merge (stage 4).
+  std::int64_t midnodes_reconciled = 0;  ///< shared mid-nodes two solids placed differently (put on the chord)
+  std::int64_t midnodes_straightened_at_merge = 0;  ///< mid-nodes put on their chord after that
+  // Result.
+  std::int64_t nodes = 0, corner_nodes = 0, tets = 0, boundary_triangles = 0;
+  double min_dihedral_deg = 0;             ///< smallest dihedral angle of the linear tets
+  double median_tet_min_dihedral_deg = 0;  ///< median over tets of each tet's smallest dihedral
+  double tets_below_10_deg = 0;            ///< share (0..1) of tets whose smallest dihedral is below 10 degrees
+  cad::ProjectionStats projection;
+  double seconds_surface = 0, seconds_core = 0, seconds_refine = 0, seconds_merge = 0, seconds_total = 0;
+};
+
+/// A tetrahedral FEM mesh of a CAD model.
+struct FemMesh {
+  /// Nodes (#N by 3) and tets (#K by 4 or 10, node order of types.h: n1..n4 m12 m23 m31 m14 m24 m34).
+  TetMesh mesh;
+  /// #K: the CAD solid (0-based, cad_model.h order) each tet fills.
+  std::vector<std::int32_t> tet_solid;
+  /// The triangles of every CAD face, each once (#F by nodes_per_triangle: n1 n2 n3, then for
+  /// order 2 m12 m23 m31), oriented outward of the lowest-numbered solid the face bounds. Faces
+  /// shared by two solids are inside the mesh; the others are its boundary.
+  std::vector<Index> tri;
+  int nodes_per_triangle = 3;
+  /// #F: the CAD face (0-based: FreeCAD's Face<k+1>) of each triangle.
+  std::vector<std::int32_t> tri_face;
+
+  Index num_triangles() const { return static_cast<Index>(tri_face.size()); }
+};
+
+/// How far the nodes of a FemMesh's face triangles lie from their CAD faces.
+struct CadDistance {
+  double max_corner = 0;   ///< largest distance of a triangle corner to a face it is on, model units
+  double max_midnode = 0;  ///< the same for order-2 mid-nodes (0 for order 1)
+  std::int64_t pairs = 0;  ///< (node, face) pairs measured: a node on triangles of k faces counts k times
+  std::int64_t worst_node = -1;
+  int worst_face = -1;
+};
+
+/// Measures, for every node of every face triangle (corners and mid-nodes) and every CAD face whose
+/// triangles use it, cad::distance_to_face (the bounded face, as FreeCAD's getNodesByFace
+/// measures). Slow (one extrema search per pair): for tests and reports.
+CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh);
+
+/// Meshes every solid of `model` (see the file comment). Throws InputError naming the option for
+/// bad options and naming the CAD face, edge or solid for a model that cannot be meshed as given;
+/// MeshingError when a stage fails on valid input (code kCancelled when cancelled).
+FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats = nullptr);
+
+}  // namespace bsptet::fem

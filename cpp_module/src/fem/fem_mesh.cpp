@@ -1,0 +1,378 @@
+// FemBspTet FEM pipeline: CAD surface, core, refinement and merge of the solids (see fem_mesh.h).
+#include "bsptet/fem/fem_mesh.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "bsptet/cad/cad_surface.h"
+#include "bsptet/errors.h"
+#include "bsptet/mesher.h"
+#include "bsptet/quality_refine.h"
+#include "bsptet/tet10.h"
+#include "bsptet/tet_shape.h"
+
+namespace bsptet::fem {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Tet edges in the mid-node order of types.h: m12 m23 m31 m14 m24 m34.
+constexpr int kTetEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+
+void check_options(const FemOptions& o) {
+  auto bad = [](const std::string& what) { throw InputError(ErrorCode::kBadArgument, "fem", -1, what); };
+  auto non_negative = [&](double value, const char* name) {
+    if (!std::isfinite(value) || value < 0) {
+      std::ostringstream what;
+      what << "option " << name << " must be a finite number >= 0, got " << value;
+      bad(what.str());
+    }
+  };
+  non_negative(o.size, "size");
+  non_negative(o.min_size, "min_size");
+  non_negative(o.points_per_circle, "points_per_circle");
+  non_negative(o.grading, "grading");
+  if (o.order != 1 && o.order != 2) bad("option order must be 1 or 2, got " + std::to_string(o.order));
+  if (o.optimize_rounds < 0) bad("option optimize_rounds must be >= 0");
+  if (o.face_rounds < 0) bad("option face_rounds must be >= 0");
+  for (const auto& [face, size] : o.size_by_face) {
+    if (!std::isfinite(size) || size <= 0) {
+      std::ostringstream what;
+      what << "option size_by_face: the size of Face" << face + 1 << " must be a finite number > 0, got " << size;
+      bad(what.str());
+    }
+  }
+}
+
+/// Rethrows a stage's error with the solid named first (same type, code and index).
+[[noreturn]] void rethrow_for_solid(const Error& e, const cad::CadModel& model, int solid) {
+  const std::string what = model.source + ": Solid" + std::to_string(solid + 1) + ": " + e.what();
+  if (dynamic_cast<const InputError*>(&e)) throw InputError(e.code(), e.stage(), e.index(), what);
+  throw MeshingError(e.code(), e.stage(), e.index(), what);
+}
+
+Vec3 midpoint(const Vec3& a, const Vec3& b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)}; }
+bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+}  // namespace
+
+FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats) {
+  const auto start = Clock::now();
+  check_options(options);
+  FemStats st;
+  st.solids = model.num_solids();
+  st.faces = model.num_faces();
+  const int n_solids = model.num_solids();
+  auto report = [&](const std::string& stage, double f) {
+    if (options.progress) options.progress(stage, std::clamp(f, 0.0, 1.0));
+  };
+  auto check_cancel = [&] {
+    if (options.cancelled && options.cancelled())
+      throw MeshingError(ErrorCode::kCancelled, "fem", -1, "cancelled");
+  };
+
+  // ---- 1. Surface. ----
+  cad::CadSurfaceOptions so;
+  so.size.size = options.size;
+  so.size.min_size = options.min_size;
+  so.size.points_per_circle = options.points_per_circle;
+  so.size.grading = options.grading;
+  so.size.size_by_face = options.size_by_face;
+  so.face_rounds = options.face_rounds;
+  so.progress = [&](const std::string& stage, double f) { report("surface: " + stage, 0.1 * f); };
+  so.cancelled = options.cancelled;
+  cad::CadSurfaceStats sst;
+  auto t = Clock::now();
+  const cad::CadSurface surface = cad::mesh_cad_surface(model, so, &sst);
+  st.seconds_surface = seconds_since(t);
+  st.size = sst.size;
+  st.min_size = sst.min_size;
+  st.surface_nodes = sst.nodes;
+  st.surface_triangles = sst.triangles;
+
+  // Faces that bound two solids: kept as meshed in both (fem_mesh.h).
+  std::vector<int> solids_of_face(static_cast<std::size_t>(model.num_faces()), 0);
+  std::vector<std::vector<std::int32_t>> faces_of_solid(static_cast<std::size_t>(n_solids));
+  for (int s = 0; s < n_solids; ++s) {
+    auto& faces = faces_of_solid[static_cast<std::size_t>(s)];
+    faces = surface.solid_tag[static_cast<std::size_t>(s)];
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    for (std::int32_t f : faces) ++solids_of_face[static_cast<std::size_t>(f)];
+  }
+  for (int n : solids_of_face) st.shared_faces += n > 1 ? 1 : 0;
+
+  std::shared_ptr<cad::CadProjector> projector;
+  const ProjectionHook hook = cad::make_projection_hook(model, &projector);
+
+  // Merged numbering: corner nodes (the CAD surface nodes first), mid-nodes apart until the end.
+  std::vector<double> corner_xyz = surface.xyz;
+  std::vector<Vec3> mid_xyz;
+  std::vector<std::array<Index, 2>> mid_edge;          // merged corner ids of each mid-node's edge
+  std::vector<char> mid_conflict;                      // two solids placed it differently
+  std::map<std::array<Index, 2>, Index> mid_of_edge;   // sorted corner pair -> mid-node
+  std::vector<Index> tets;                             // merged ids; mid-nodes as -(1 + mid index)
+  FemMesh out;
+  // Triangles, deduplicated by their sorted corners (a shared face's triangles come twice).
+  std::set<std::array<Index, 3>> seen_triangles;
+  std::vector<std::array<Index, 3>> tri_corners;
+  const int npt = options.order == 2 ? 10 : 4;
+
+  for (int s = 0; s < n_solids; ++s) {
+    check_cancel();
+    const double share = 0.9 / n_solids, base = 0.1 + share * s;
+    const std::string name = "Solid" + std::to_string(s + 1);
+    std::vector<Index> node_of;
+    const SurfaceMesh solid = surface.solid_surface(s, &node_of);
+
+    // ---- 2. Core. ----
+    MeshOptions mo;
+    mo.progress = [&](const std::string& stage, double f) { report(name + ": " + stage, base + 0.3 * share * f); };
+    mo.cancelled = options.cancelled;
+    MeshStats mst;
+    TetMesh core;
+    t = Clock::now();
+    try {
+      core = check_and_tetrahedralize(solid, SurfaceCheckOptions{}, mo, &mst);
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::kCancelled) throw;
+      rethrow_for_solid(e, model, s);
+    }
+    st.seconds_core += seconds_since(t);
+    st.core_points += mst.points;
+    st.core_tets += mst.tets;
+    st.core_steiner_points += mst.steiner_points;
+
+    // ---- 3. Refinement. ----
+    RefineOptions ro;
+    ro.size = sst.size;
+    ro.min_size = sst.min_size;
+    for (const auto& [face, size] : options.size_by_face) ro.size_by_tag[face] = size;
+    ro.size_from_surface = true;
+    ro.grading = options.grading;
+    ro.order = options.order;
+    ro.optimize_rounds = options.optimize_rounds;
+    ro.projection = hook;
+    for (std::int32_t f : faces_of_solid[static_cast<std::size_t>(s)])
+      if (solids_of_face[static_cast<std::size_t>(f)] > 1) ro.fixed_tags.push_back(f);
+    ro.progress = [&](const std::string& stage, double f) {
+      report(name + ": " + stage, base + 0.3 * share + 0.7 * share * f);
+    };
+    ro.cancelled = options.cancelled;
+    RefineStats rst;
+    SurfaceMesh boundary;
+    TetMesh refined;
+    t = Clock::now();
+    try {
+      refined = refine_quality(solid, core, ro, &rst, &boundary);
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::kCancelled) throw;
+      rethrow_for_solid(e, model, s);
+    }
+    st.seconds_refine += seconds_since(t);
+    st.surface_splits += rst.surface_splits;
+    st.splits_fixed_surface += rst.splits_fixed_surface;
+    st.projection_refused += rst.projection_rejected;
+    st.midnodes_projected += rst.midnodes_projected;
+    st.midnodes_straightened += rst.midnodes_straightened;
+    st.curving_conflicts_left += rst.curving_conflicts_left;
+
+    // ---- 4. Merge this solid. ----
+    t = Clock::now();
+    // The core and the refinement keep the input points first, in order (mesher.h,
+    // quality_refine.h): the solid's surface nodes are the CAD nodes node_of[i].
+    const Index n_surface = solid.num_points();
+    for (Index i = 0; i < n_surface; ++i)
+      if (i >= refined.num_points() || !same(refined.point(i), solid.point(i)))
+        throw MeshingError(ErrorCode::kInternal, "fem", i,
+                           model.source + ": " + name + ": surface node " + std::to_string(i) +
+                               " is not at its place in the refined mesh");
+    std::vector<Index> corner_of(static_cast<std::size_t>(refined.num_points()), -1);
+    for (Index i = 0; i < n_surface; ++i) corner_of[static_cast<std::size_t>(i)] = node_of[static_cast<std::size_t>(i)];
+    const Index nk = refined.num_tets();
+    for (Index k = 0; k < nk; ++k)
+      for (int c = 0; c < 4; ++c) {
+        const Index v = refined.tet[static_cast<std::size_t>(npt * k + c)];
+        Index& id = corner_of[static_cast<std::size_t>(v)];
+        if (id >= 0) continue;
+        id = static_cast<Index>(corner_xyz.size() / 3);
+        const Vec3 p = refined.point(v);
+        corner_xyz.insert(corner_xyz.end(), {p.x, p.y, p.z});
+      }
+    auto mid_id = [&](Index a, Index b, const Vec3& p) {
+      const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+      auto [it, fresh] = mid_of_edge.emplace(key, static_cast<Index>(mid_xyz.size()));
+      if (fresh) {
+        mid_xyz.push_back(p);
+        mid_edge.push_back(key);
+        mid_conflict.push_back(0);
+      } else if (!same(mid_xyz[static_cast<std::size_t>(it->second)], p)) {
+        mid_conflict[static_cast<std::size_t>(it->second)] = 1;
+      }
+      return it->second;
+    };
+    for (Index k = 0; k < nk; ++k) {
+      const Index* q = &refined.tet[static_cast<std::size_t>(npt * k)];
+      std::array<Index, 4> c{};
+      for (int i = 0; i < 4; ++i) c[i] = corner_of[static_cast<std::size_t>(q[i])];
+      tets.insert(tets.end(), c.begin(), c.end());
+      if (npt == 10)
+        for (int e = 0; e < 6; ++e)
+          tets.push_back(-1 - mid_id(c[kTetEdge[e][0]], c[kTetEdge[e][1]], refined.point(q[4 + e])));
+      out.tet_solid.push_back(s);
+    }
+    for (Index f = 0; f < boundary.num_triangles(); ++f) {
+      std::array<Index, 3> c{};
+      for (int i = 0; i < 3; ++i) c[i] = corner_of[static_cast<std::size_t>(boundary.tri[static_cast<std::size_t>(3 * f + i)])];
+      std::array<Index, 3> key = c;
+      std::sort(key.begin(), key.end());
+      if (!seen_triangles.insert(key).second) continue;
+      tri_corners.push_back(c);
+      out.tri_face.push_back(boundary.tag[static_cast<std::size_t>(f)]);
+    }
+    st.seconds_merge += seconds_since(t);
+  }
+
+  t = Clock::now();
+  const Index n_mid = static_cast<Index>(mid_xyz.size());
+  auto corner = [&](Index v) {
+    return Vec3{corner_xyz[3 * static_cast<std::size_t>(v)], corner_xyz[3 * static_cast<std::size_t>(v) + 1],
+                corner_xyz[3 * static_cast<std::size_t>(v) + 2]};
+  };
+  auto chord = [&](Index m) {
+    const auto& e = mid_edge[static_cast<std::size_t>(m)];
+    return midpoint(corner(e[0]), corner(e[1]));
+  };
+  if (npt == 10) {
+    // Shared mid-nodes two solids placed differently go on their chord; then every curved tet that
+    // is not valid gets its mid-nodes on their chords, until all pass (a straight tet passes when
+    // its corners are positive).
+    std::vector<char> dirty(static_cast<std::size_t>(n_mid), 0);
+    for (Index m = 0; m < n_mid; ++m)
+      if (mid_conflict[static_cast<std::size_t>(m)]) {
+        ++st.midnodes_reconciled;
+        mid_xyz[static_cast<std::size_t>(m)] = chord(m);
+        dirty[static_cast<std::size_t>(m)] = 1;
+      }
+    const Index nk = static_cast<Index>(out.tet_solid.size());
+    for (bool changed = st.midnodes_reconciled > 0; changed;) {
+      changed = false;
+      for (Index k = 0; k < nk; ++k) {
+        const Index* q = &tets[static_cast<std::size_t>(10 * k)];
+        bool touched = false;
+        for (int e = 0; e < 6; ++e) touched = touched || dirty[static_cast<std::size_t>(-1 - q[4 + e])];
+        if (!touched) continue;
+        double x[30];
+        for (int i = 0; i < 10; ++i) {
+          const Vec3 p = i < 4 ? corner(q[i]) : mid_xyz[static_cast<std::size_t>(-1 - q[i])];
+          x[3 * i] = p.x, x[3 * i + 1] = p.y, x[3 * i + 2] = p.z;
+        }
+        if (certify_tet10(x) == Tet10Validity::kCertified) continue;
+        for (int e = 0; e < 6; ++e) {
+          const Index m = -1 - q[4 + e];
+          const Vec3 c = chord(m);
+          if (same(mid_xyz[static_cast<std::size_t>(m)], c)) continue;
+          mid_xyz[static_cast<std::size_t>(m)] = c;
+          dirty[static_cast<std::size_t>(m)] = 1;
+          ++st.midnodes_straightened_at_merge;
+          changed = true;
+        }
+      }
+    }
+  }
+
+  // Final numbering: used corner nodes in order, then the mid-nodes.
+  const Index n_corner_all = static_cast<Index>(corner_xyz.size() / 3);
+  std::vector<Index> renum(static_cast<std::size_t>(n_corner_all), -1);
+  for (std::size_t i = 0; i < tets.size(); ++i)
+    if (npt == 4 || i % 10 < 4) renum[static_cast<std::size_t>(tets[i])] = 0;
+  Index n_corner = 0;
+  for (Index v = 0; v < n_corner_all; ++v)
+    if (renum[static_cast<std::size_t>(v)] == 0) {
+      renum[static_cast<std::size_t>(v)] = n_corner++;
+      const Vec3 p = corner(v);
+      out.mesh.xyz.insert(out.mesh.xyz.end(), {p.x, p.y, p.z});
+    }
+  for (const Vec3& p : mid_xyz) out.mesh.xyz.insert(out.mesh.xyz.end(), {p.x, p.y, p.z});
+  auto final_id = [&](Index v) { return v >= 0 ? renum[static_cast<std::size_t>(v)] : n_corner + (-1 - v); };
+  out.mesh.nodes_per_tet = npt;
+  out.mesh.tet.reserve(tets.size());
+  for (Index v : tets) out.mesh.tet.push_back(final_id(v));
+  out.nodes_per_triangle = npt == 10 ? 6 : 3;
+  for (const auto& c : tri_corners) {
+    for (Index v : c) out.tri.push_back(renum[static_cast<std::size_t>(v)]);
+    if (npt == 10)
+      for (int e = 0; e < 3; ++e) {
+        const Index a = c[e], b = c[(e + 1) % 3];
+        auto it = mid_of_edge.find({std::min(a, b), std::max(a, b)});
+        if (it == mid_of_edge.end())
+          throw MeshingError(ErrorCode::kInternal, "fem", -1,
+                             model.source + ": a face triangle's edge has no mid-node in the tets");
+        out.tri.push_back(n_corner + it->second);
+      }
+  }
+  st.seconds_merge += seconds_since(t);
+
+  // ---- Figures. ----
+  st.corner_nodes = n_corner;
+  st.nodes = out.mesh.num_points();
+  st.tets = out.mesh.num_tets();
+  st.boundary_triangles = out.num_triangles();
+  std::vector<double> worst(static_cast<std::size_t>(st.tets));
+  for (Index k = 0; k < out.mesh.num_tets(); ++k) {
+    const Index* q = &out.mesh.tet[static_cast<std::size_t>(npt * k)];
+    worst[static_cast<std::size_t>(k)] =
+        tet_min_dihedral_deg(out.mesh.point(q[0]), out.mesh.point(q[1]), out.mesh.point(q[2]), out.mesh.point(q[3]));
+  }
+  if (!worst.empty()) {
+    st.min_dihedral_deg = *std::min_element(worst.begin(), worst.end());
+    std::int64_t below = 0;
+    for (double w : worst) below += w < 10 ? 1 : 0;
+    st.tets_below_10_deg = static_cast<double>(below) / static_cast<double>(worst.size());
+    std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(worst.size() / 2), worst.end());
+    st.median_tet_min_dihedral_deg = worst[worst.size() / 2];
+  }
+  st.projection = projector->stats();
+  st.seconds_total = seconds_since(start);
+  report("done", 1.0);
+  if (stats) *stats = st;
+  return out;
+}
+
+CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh) {
+  std::set<std::pair<Index, std::int32_t>> pairs;  // (node, face), each measured once
+  const int npf = mesh.nodes_per_triangle;
+  for (Index t = 0; t < mesh.num_triangles(); ++t)
+    for (int i = 0; i < npf; ++i)
+      pairs.insert({mesh.tri[static_cast<std::size_t>(npf * t + i)], mesh.tri_face[static_cast<std::size_t>(t)]});
+  // Corner nodes are the tets' first four nodes.
+  std::vector<char> is_corner(static_cast<std::size_t>(mesh.mesh.num_points()), 0);
+  const int npt = mesh.mesh.nodes_per_tet;
+  for (std::size_t i = 0; i < mesh.mesh.tet.size(); ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(npt)) < 4) is_corner[static_cast<std::size_t>(mesh.mesh.tet[i])] = 1;
+  CadDistance d;
+  double worst = -1;
+  for (const auto& [node, face] : pairs) {
+    const double dist = cad::distance_to_face(model, face, mesh.mesh.point(node));
+    double& max = is_corner[static_cast<std::size_t>(node)] ? d.max_corner : d.max_midnode;
+    max = std::max(max, dist);
+    if (dist > worst) {
+      worst = dist;
+      d.worst_node = node;
+      d.worst_face = face;
+    }
+    ++d.pairs;
+  }
+  return d;
+}
+
+}  // namespace bsptet::fem
