@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -166,10 +167,10 @@ class FaceMesher {
     return edges;
   }
 
-  bool split(int a, int b);
+  bool split(int a, int b, bool untangle = false);
   bool flip(int a, int b, bool in_3d = false);
   int untangle_pass();
-  bool collapse(int v, int w);
+  bool collapse(int v, int w, bool untangle = false);
   bool smooth(int v);
   int split_pass();
   int collapse_pass();
@@ -185,7 +186,7 @@ class FaceMesher {
   std::vector<std::pair<Vec3, double>> boundary_sizes_;
 };
 
-bool FaceMesher::split(int a, int b) {
+bool FaceMesher::split(int a, int b, bool untangle) {
   const auto [t0, t1] = edge_tris(a, b);
   if (t0 < 0 || t1 < 0) return false;  // a boundary edge: never split
   const int c = opposite(tris_[static_cast<std::size_t>(t0)], a, b);
@@ -193,9 +194,15 @@ bool FaceMesher::split(int a, int b) {
   const Uv uv = mid(verts_[a].uv, verts_[b].uv);
   const int m = add_vertex(uv, eval(uv));
   // Splits are judged in (u, v) even at a pole: they refine big start triangles whose 3D shape
-  // is poor anyway, until (u, v) and 3D agree.
+  // is poor anyway, until (u, v) and 3D agree. Untangling splits must leave no folded triangle.
   auto uv_ok = [&](int x, int y, int z) { return uv_orient(verts_[x].uv, verts_[y].uv, verts_[z].uv) > 0; };
-  if (!uv_ok(a, m, c) || !uv_ok(m, b, c) || !uv_ok(b, m, d) || !uv_ok(m, a, d)) {
+  bool ok = uv_ok(a, m, c) && uv_ok(m, b, c) && uv_ok(b, m, d) && uv_ok(m, a, d);
+  if (ok && untangle) {
+    const double before = std::min(quality(a, b, c), quality(b, a, d));
+    const double after = std::min({quality(a, m, c), quality(m, b, c), quality(b, m, d), quality(m, a, d)});
+    ok = after > 0;  // only splits that leave no fold among their four triangles
+  }
+  if (!ok) {
     verts_.pop_back();
     vt_.pop_back();
     return false;
@@ -235,9 +242,25 @@ bool FaceMesher::flip(int a, int b, bool in_3d) {
   return true;
 }
 
-bool FaceMesher::collapse(int v, int w) {
+bool FaceMesher::collapse(int v, int w, bool untangle) {
   if (verts_[v].boundary) return false;
   const auto ring = vt_[static_cast<std::size_t>(v)];
+  // Link condition: v and w may share only the two corners opposite their edge; another common
+  // neighbour would make an edge twice (two triangles on the same three nodes).
+  std::vector<int> around_v, around_w;
+  for (int t : ring)
+    for (int u : tris_[static_cast<std::size_t>(t)])
+      if (u != v) around_v.push_back(u);
+  for (int t : vt_[static_cast<std::size_t>(w)])
+    for (int u : tris_[static_cast<std::size_t>(t)])
+      if (u != w) around_w.push_back(u);
+  std::sort(around_v.begin(), around_v.end());
+  around_v.erase(std::unique(around_v.begin(), around_v.end()), around_v.end());
+  std::sort(around_w.begin(), around_w.end());
+  around_w.erase(std::unique(around_w.begin(), around_w.end()), around_w.end());
+  std::vector<int> common;
+  std::set_intersection(around_v.begin(), around_v.end(), around_w.begin(), around_w.end(), std::back_inserter(common));
+  if (common.size() != 2) return false;
   double before = kInf, after = kInf;
   int shared = 0;
   for (int t : ring) {
@@ -252,11 +275,14 @@ bool FaceMesher::collapse(int v, int w) {
       if (u == v) u = w;
     if (!valid(y[0], y[1], y[2])) return false;
     after = std::min(after, quality(y[0], y[1], y[2]));
-    for (int u : y)
-      if (u != w && edge_ratio(w, u) > kSplitRatio) return false;
+    if (!untangle)
+      for (int u : y)
+        if (u != w && edge_ratio(w, u) > kSplitRatio) return false;
   }
   if (shared != 2) return false;
-  if (after < std::min(0.3, before)) return false;
+  // Untangling: any collapse that raises the worst triangle around v; otherwise the worst may
+  // drop to 0.3 at most.
+  if (untangle ? !(after > before) : after < std::min(0.3, before)) return false;
   for (int t : ring) {
     Tri y = tris_[static_cast<std::size_t>(t)];
     kill_tri(t);
@@ -363,12 +389,21 @@ int FaceMesher::untangle_pass() {
   int total = 0;
   for (int sweep = 0; sweep < 8; ++sweep) {
     int done = 0;
-    for (std::size_t t = 0; t < tris_.size(); ++t) {
+    const std::size_t count = tris_.size();  // triangles made in this sweep wait for the next
+    for (std::size_t t = 0; t < count; ++t) {
       if (!alive_[t]) continue;
       const Tri x = tris_[t];
       if (quality(x[0], x[1], x[2]) > 0) continue;
       for (int i = 0; i < 3 && alive_[t]; ++i)
         if (flip(x[i], x[(i + 1) % 3], /*in_3d=*/true)) ++done;
+      for (int i = 0; i < 3 && alive_[t]; ++i) {
+        const int a = x[i], b = x[(i + 1) % 3];
+        if (collapse(a, b, /*untangle=*/true) || collapse(b, a, /*untangle=*/true)) ++done;
+      }
+      for (int i = 0; i < 3 && alive_[t]; ++i)
+        if (dist(verts_[x[i]].xyz, verts_[x[(i + 1) % 3]].xyz) > 2 * options_.min_size &&
+            split(x[i], x[(i + 1) % 3], /*untangle=*/true))
+          ++done;
     }
     total += done;
     if (done == 0) break;
