@@ -207,11 +207,48 @@ def _mesh_on_cad(args, progress):
     return result.mesh, dict(result.stats), list(result.notes)
 
 
+def _mesh_cad_fem(args, progress):
+    """The default for a CAD file: the FEM path (FemBspTet.fem.cad_mesh, no FreeCAD): the CAD
+    surface meshed at the size, the exact core, refinement with points and tet10 mid-nodes on
+    the CAD. Returns (mesh, stats, boundary surface with CAD face tags)."""
+    unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
+                                            ("--radius-edge", args.radius_edge),
+                                            ("--thickness-ratio", args.thickness_ratio),
+                                            ("--surface-points", args.surface_points),
+                                            ("--steiner-effort", args.steiner_effort),
+                                            ("--bsp-seed", args.bsp_seed),
+                                            ("--reorient", args.reorient or None),
+                                            ("--allow-boundary-steiner",
+                                             args.allow_boundary_steiner or None),
+                                            ("--out-of-core", getattr(args, "out_of_core", None)
+                                             or None))
+                   if value is not None]
+    if unsupported:
+        raise InputError("a CAD file is meshed by the FEM path, which does not take "
+                         + ", ".join(unsupported) + "; drop them, or add --tessellation to mesh "
+                         "OpenCASCADE's display tessellation with the core instead",
+                         where=args.input)
+    from .fem.cad_mesh import mesh_cad_file
+
+    result = mesh_cad_file(args.input, size=args.size or 0.0, min_size=args.min_size or 0.0,
+                           order=args.order, progress=lambda stage, fraction: progress(stage))
+    return result.mesh, result.stats, result.boundary
+
+
 def _cmd_mesh(args):
     progress = Progress(enabled=not args.quiet)
     t0 = time.perf_counter()
     if not hasattr(args, "max_memory_bytes"):
         _check_mesh_args(args)
+    fem_path = (_ext(args.input) in CAD_EXTENSIONS and not getattr(args, "on_cad", False)
+                and not getattr(args, "tessellation", False))
+    if fem_path:
+        progress("reading the CAD file")
+        try:
+            mesh, stats, boundary = _mesh_cad_fem(args, progress)
+        finally:
+            progress.finish()
+        return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None, boundary=boundary)
     if getattr(args, "no_straighten_midnodes", False) and not getattr(args, "on_cad", False):
         raise InputError("--no-straighten-midnodes is for --on-cad (the FreeCAD mesher's curved "
                          "tet10); without --on-cad tet10 mid-nodes stay on their straight edges")
@@ -276,10 +313,10 @@ def _cmd_mesh(args):
     return _finish_mesh(args, progress, t0, mesh, stats, surfaces)
 
 
-def _finish_mesh(args, progress, t0, mesh, stats, surfaces):
+def _finish_mesh(args, progress, t0, mesh, stats, surfaces, boundary=None):
     progress("writing")
     for out in args.output:
-        write_output(out, mesh)
+        write_output(out, mesh, boundary)
     progress.finish()
     stats["seconds_total"] = time.perf_counter() - t0
     for note in stats.get("notes", []):
@@ -480,6 +517,11 @@ def build_parser():
                         "points (only the cells an input triangle crosses are split) or one box "
                         "(the paper's auto-partition); auto (default): the Delaunay seed unless "
                         "the input triangles cross more than 4 of its tets each on average")
+    m.add_argument("--tessellation", action="store_true",
+                   help="CAD input: mesh OpenCASCADE's display tessellation with the core (sized "
+                        "only with --size; needs FreeCAD) instead of the FEM path, which meshes "
+                        "the CAD surface itself at the size (default; automatic size: the "
+                        "bounding-box diagonal / 20)")
     m.add_argument("--on-cad", action="store_true",
                    help="CAD input: mesh as the FreeCAD mesher does (needs FreeCAD): boundary "
                         "points the refinement adds and tet10 mid-nodes go onto the CAD faces and "

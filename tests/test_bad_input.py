@@ -207,8 +207,8 @@ TABLE = [
      ["unknown output format '.docx'"], ["x.docx"]),
     ("missing output folder", existing(paper_path("schoenhardt")), ["-o", "{tmp}/no/x.vtu"], 2,
      ["output directory does not exist"], ["no"]),
-    ("CAD: garbage STEP", cad_garbage, [], 2, ["cannot read this file"], ["junk.step"]),
-    ("CAD: open shell, not a solid", cad_open_shell, [], 2, ["not a solid"], ["open_shell.step"]),
+    ("CAD: garbage STEP", cad_garbage, [], 2, ["not a readable STEP file"], ["junk.step"]),
+    ("CAD: open shell, not a solid", cad_open_shell, [], 2, ["no solid"], ["open_shell.step"]),
 ]
 
 
