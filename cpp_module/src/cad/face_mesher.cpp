@@ -200,7 +200,7 @@ bool FaceMesher::split(int a, int b, bool untangle) {
   if (ok && untangle) {
     const double before = std::min(quality(a, b, c), quality(b, a, d));
     const double after = std::min({quality(a, m, c), quality(m, b, c), quality(b, m, d), quality(m, a, d)});
-    ok = after > 0;  // only splits that leave no fold among their four triangles
+    ok = after > 0 && after > before;  // no fold among the four, and better than the two
   }
   if (!ok) {
     verts_.pop_back();
@@ -383,8 +383,9 @@ int FaceMesher::flip_pass() {
 }
 
 /// Triangles that still face against the surface (a fold: the start's ear-cut triangles near a
-/// pole or across a strongly curved patch) are flipped away judged in 3D alone: both new
-/// triangles must face the surface's way.
+/// pole or across a strongly curved patch) are flipped away judged in 3D alone (both new
+/// triangles must face the surface's way), or collapsed, or split, whichever raises the worst
+/// triangle there.
 int FaceMesher::untangle_pass() {
   int total = 0;
   for (int sweep = 0; sweep < 8; ++sweep) {
