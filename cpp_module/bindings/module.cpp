@@ -201,6 +201,7 @@ py::tuple mesh_cad(const std::function<cad::CadModel()>& read, double size, doub
   d["seconds_refine"] = st.seconds_refine;
   d["seconds_merge"] = st.seconds_merge;
   d["seconds_total"] = st.seconds_total;
+  d["refine_seconds_by_pass"] = st.refine_seconds_by_pass;
   return py::make_tuple(points_array(fm.mesh), tets_array(fm.mesh), tet_solid, tri, tri_face, d);
 }
 

@@ -71,6 +71,9 @@ int main(int argc, char** argv) {
                 (long long)st.projection.no_common_edge);
     std::printf("  seconds: surface %.3f core %.3f refine %.3f merge %.3f total %.3f\n", st.seconds_surface,
                 st.seconds_core, st.seconds_refine, st.seconds_merge, st.seconds_total);
+    std::printf("  refine seconds by pass:");
+    for (const auto& [pass, seconds] : st.refine_seconds_by_pass) std::printf(" %s %.3f", pass.c_str(), seconds);
+    std::printf("\n");
     if (distance) {
       const fem::CadDistance d = fem::measure_cad_distance(model, mesh);
       std::printf("  distance to CAD: corners max %.3g, mid-nodes max %.3g (%.3g of the diagonal); %lld node-face "

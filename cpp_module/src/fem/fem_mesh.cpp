@@ -185,6 +185,7 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.midnodes_projected += rst.midnodes_projected;
     st.midnodes_straightened += rst.midnodes_straightened;
     st.curving_conflicts_left += rst.curving_conflicts_left;
+    for (const auto& [pass, seconds] : rst.seconds_by_pass) st.refine_seconds_by_pass[pass] += seconds;
 
     // ---- 4. Merge this solid. ----
     t = Clock::now();

@@ -24,7 +24,9 @@
 // Solids that touch only along a CAD edge or at a CAD vertex share the CAD nodes there, but the
 // refinement of one solid may add points on such an edge that the other does not have: the merged
 // mesh is then not node-conforming along that edge (it is along shared faces).
-// Solids that overlap (a compound not made conformal) give overlapping tets; nothing checks that.
+// Solids of a compound that was not made conformal (no general fuse) are meshed one by one: where
+// two of them touch along coincident but distinct CAD faces the mesh has two sets of nodes there
+// (not connected), and where they overlap the tets overlap; nothing checks either.
 //
 // Output node order: the CAD surface nodes (cad_surface.h order, unused ones dropped), then each
 // solid's added corner nodes (solid order, then the refinement's order), then the mid-nodes of an
@@ -96,6 +98,8 @@ struct FemStats {
   double tets_below_10_deg = 0;            ///< share (0..1) of tets whose smallest dihedral is below 10 degrees
   cad::ProjectionStats projection;
   double seconds_surface = 0, seconds_core = 0, seconds_refine = 0, seconds_merge = 0, seconds_total = 0;
+  /// The refinement's wall seconds per pass, summed over the solids (RefineStats::seconds_by_pass).
+  std::map<std::string, double> refine_seconds_by_pass;
 };
 
 /// A tetrahedral FEM mesh of a CAD model.
