@@ -616,3 +616,146 @@ def _fc_message(exc):
     if text.startswith(prefix) and text.endswith(")"):
         text = text[len(prefix):-1]
     return text or type(exc).__name__
+
+
+# --------------------------------------------------------------------------------------------
+# fins
+# --------------------------------------------------------------------------------------------
+
+#: :func:`flip_out_fins`: a triangle whose largest angle exceeds this (degrees) is a fin.
+FIN_ANGLE_DEGREES = 175.0
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _largest_angle(p, q, r):
+    """Largest angle of triangle (p, q, r) in degrees, and the index (0, 1, 2) of its vertex
+    (points as tuples: faster than numpy for single points)."""
+    best, at = -1.0, 0
+    for k, (x, y, z) in enumerate(((p, q, r), (q, r, p), (r, p, q))):
+        u, v = _sub(y, x), _sub(z, x)
+        nu, nv = math.sqrt(_dot(u, u)), math.sqrt(_dot(v, v))
+        if nu == 0 or nv == 0:
+            return 180.0, k
+        a = math.degrees(math.acos(max(-1.0, min(1.0, _dot(u, v) / (nu * nv)))))
+        if a > best:
+            best, at = a, k
+    return best, at
+
+
+def flip_out_fins(surface, frozen_tags=(), fin_angle=FIN_ANGLE_DEGREES):
+    """Flip away the fins of a CAD tessellation: triangles whose largest angle exceeds
+    ``fin_angle`` (OpenCASCADE makes them where three points of one CAD edge, or of a face's
+    boundary, are nearly collinear: a triangle of almost no area). Every tet on a fin is flat,
+    whatever the volume mesher does.
+
+    A fin (b, c, a) with its largest angle at b is removed by flipping its longest edge (c, a)
+    with the triangle (a, c, x) across it, into (b, c, x) and (b, x, a), when that triangle has
+    the same face tag (not in ``frozen_tags``), the edge (b, x) is not already an edge, both new
+    triangles face the way (a, c, x) did, and their largest angles are both below the fin's.
+    No vertex moves or is added, so every vertex stays where the tessellation put it (on its CAD
+    face); triangles keep their face's tag. Passes until nothing changes (each flip lowers the
+    largest angle of the pair it replaces; at most 4 passes).
+
+    Returns ``(Surface, stats)``; stats: ``fins_before``, ``fins_after``, ``flips``. The input
+    is returned unchanged when no flip was made.
+    """
+    P = [tuple(p) for p in np.asarray(surface.points, dtype=np.float64).tolist()]
+    T = [list(t) for t in np.asarray(surface.triangles).tolist()]
+    tags = None if surface.face_tags is None else [int(t) for t in surface.face_tags.tolist()]
+    frozen = set(int(t) for t in frozen_tags)
+    edge_tri = {}
+    for i, t in enumerate(T):
+        for k in range(3):
+            edge_tri[(t[k], t[(k + 1) % 3])] = i
+
+    def largest(t):
+        return _largest_angle(P[t[0]], P[t[1]], P[t[2]])
+
+    def normal(t):
+        return _cross(_sub(P[t[1]], P[t[0]]), _sub(P[t[2]], P[t[0]]))
+
+    before = sum(1 for t in T if largest(t)[0] > fin_angle)
+    flips = 0
+    for _ in range(4):
+        changed = False
+        for i in range(len(T)):
+            t = T[i]
+            angle, k = largest(t)
+            if angle <= fin_angle:
+                continue
+            b, c, a = t[k], t[(k + 1) % 3], t[(k + 2) % 3]
+            j = edge_tri.get((a, c))
+            if j is None or j == i:
+                continue
+            if tags is not None and (tags[j] != tags[i] or tags[i] in frozen):
+                continue
+            s = T[j]
+            x = [v for v in s if v != a and v != c][0]
+            if x == b or (b, x) in edge_tri or (x, b) in edge_tri:
+                continue
+            n_s = normal([a, c, x])
+            new = ([b, c, x], [b, x, a])
+            if not all(_dot(normal(u), n_s) > 0 and largest(u)[0] < angle for u in new):
+                continue
+            for tri in (t, s):
+                for m in range(3):
+                    del edge_tri[(tri[m], tri[(m + 1) % 3])]
+            T[i], T[j] = new[0], new[1]
+            for idx in (i, j):
+                for m in range(3):
+                    edge_tri[(T[idx][m], T[idx][(m + 1) % 3])] = idx
+            flips += 1
+            changed = True
+        if not changed:
+            break
+    after = sum(1 for t in T if largest(t)[0] > fin_angle)
+    stats = {"fins_before": before, "fins_after": after, "flips": flips}
+    if flips == 0:
+        return surface, stats
+    return Surface(surface.points, np.asarray(T, dtype=np.int64), surface.face_tags,
+                   surface.face_names, surface.source), stats
+
+
+def shared_face_tags(surfaces):
+    """Face tags that appear in more than one solid's surface (faces two solids share: both
+    sides must stay identical, so they are never changed)."""
+    counts = {}
+    for surf in surfaces:
+        for tag in set(surf.face_tags.tolist()):
+            counts[tag] = counts.get(tag, 0) + 1
+    return {tag for tag, c in counts.items() if c > 1}
+
+
+def flip_out_fins_of(surfaces):
+    """Each solid's tessellation through :func:`flip_out_fins` (faces two solids share are left
+    alone). A changed surface is used only if it passes the core's exact input check; else the
+    solid keeps its tessellation. Returns ``(surfaces, stats)``: ``fins_before``, ``fins_after``
+    and ``flips`` summed over the solids whose surface is used, and ``not_used``."""
+    from . import core
+
+    frozen = shared_face_tags(surfaces)
+    out, total = [], {"fins_before": 0, "fins_after": 0, "flips": 0, "not_used": 0}
+    for surf in surfaces:
+        new, st = flip_out_fins(surf, frozen_tags=frozen)
+        if new is not surf:
+            try:
+                core.check_surface(new)
+            except InputError:
+                total["not_used"] += 1
+                out.append(surf)
+                continue
+        for k in ("fins_before", "fins_after", "flips"):
+            total[k] += st[k]
+        out.append(new)
+    return out, total

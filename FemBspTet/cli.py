@@ -62,18 +62,17 @@ def _ext(path):
 
 def load_input(path, size=None):
     """Reads a surface file or tessellates a CAD file (its fins flipped away,
-    :func:`FemBspTet.surface_remesh.flip_out_fins`). Returns a list of Surfaces (one per solid)."""
+    :func:`FemBspTet.cad_tessellation.flip_out_fins`). Returns a list of Surfaces (one per solid)."""
     ext = _ext(path)
     if ext in SURFACE_EXTENSIONS:
         from .surface_io import read_surface
 
         return [read_surface(path)]
     if ext in CAD_EXTENSIONS:
-        from .cad_tessellation import tessellate_file
-        from .mesh_pipeline import flip_out_fins_of
+        from .cad_tessellation import flip_out_fins_of, tessellate_file
 
-        # OpenCASCADE's fins (near-collinear triangles) flipped inside their faces, as the
-        # FreeCAD pipeline does: every tet on a fin is flat
+        # OpenCASCADE's fins (near-collinear triangles) flipped inside their faces: every tet
+        # on a fin is flat
         return flip_out_fins_of(tessellate_file(path, size=size))[0]
     raise InputError(
         f"unknown input format '{ext or '(no extension)'}'; supported: "
@@ -174,39 +173,6 @@ def _write_intersections(path, exc):
           f"{path} (face tags = triangle indices)", file=sys.stderr)
 
 
-def _mesh_on_cad(args, progress):
-    """``mesh --on-cad``: the FreeCAD mesher's pipeline (mesh_pipeline.mesh_cad_shape) on a CAD
-    file: boundary Steiner points and tet10 mid-nodes on the CAD faces. Returns (mesh, stats,
-    notes)."""
-    unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
-                                            ("--surface-points", args.surface_points),
-                                            ("--steiner-effort", args.steiner_effort),
-                                            ("--bsp-seed", args.bsp_seed),
-                                            ("--reorient", args.reorient or None),
-                                            ("--write-intersections", args.write_intersections))
-                   if value is not None]
-    if unsupported:
-        raise InputError("--on-cad does not take " + ", ".join(unsupported) + " (the FreeCAD "
-                         "mesher's pipeline has no such parameter); drop it or --on-cad")
-    if _ext(args.input) not in CAD_EXTENSIONS:
-        raise InputError("--on-cad needs a CAD file (" + ", ".join(CAD_EXTENSIONS) + ")",
-                         where=args.input)
-    from .cad_tessellation import read_cad_shape
-    from .mesh_pipeline import MeshParameters, mesh_cad_shape
-
-    shape = read_cad_shape(args.input)
-    params = MeshParameters(max_size=args.size or 0.0, min_size=args.min_size or 0.0,
-                            order=args.order, quality_bound=args.radius_edge or 0.0,
-                            allow_boundary_steiner=args.allow_boundary_steiner,
-                            compare_tetgen=False,
-                            straighten_midnodes=not args.no_straighten_midnodes)
-    if args.thickness_ratio is not None:
-        params.thickness_ratio = args.thickness_ratio
-    result = mesh_cad_shape(shape, params, progress=lambda stage, fraction: progress(stage),
-                            source=os.path.basename(args.input))
-    return result.mesh, dict(result.stats), list(result.notes)
-
-
 def _mesh_cad_fem(args, progress):
     """The default for a CAD file: the FEM path (FemBspTet.fem.cad_mesh, no FreeCAD): the CAD
     surface meshed at the size, the exact core, refinement with points and tet10 mid-nodes on
@@ -240,8 +206,7 @@ def _cmd_mesh(args):
     t0 = time.perf_counter()
     if not hasattr(args, "max_memory_bytes"):
         _check_mesh_args(args)
-    fem_path = (_ext(args.input) in CAD_EXTENSIONS and not getattr(args, "on_cad", False)
-                and not getattr(args, "tessellation", False))
+    fem_path = _ext(args.input) in CAD_EXTENSIONS and not getattr(args, "tessellation", False)
     if fem_path:
         progress("reading the CAD file")
         try:
@@ -249,20 +214,6 @@ def _cmd_mesh(args):
         finally:
             progress.finish()
         return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None, boundary=boundary)
-    if getattr(args, "no_straighten_midnodes", False) and not getattr(args, "on_cad", False):
-        raise InputError("--no-straighten-midnodes is for --on-cad (the FreeCAD mesher's curved "
-                         "tet10); without --on-cad tet10 mid-nodes stay on their straight edges")
-    if getattr(args, "on_cad", False) and getattr(args, "out_of_core", False):
-        raise InputError("--out-of-core meshes a tessellation with the core alone; --on-cad runs the "
-                         "FreeCAD mesher's pipeline: use one of them")
-    if getattr(args, "on_cad", False):
-        progress("reading the CAD file")
-        try:
-            mesh, stats, notes = _mesh_on_cad(args, progress)
-        finally:
-            progress.finish()
-        stats["notes"] = notes
-        return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None)
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
     from . import core
@@ -522,16 +473,6 @@ def build_parser():
                         "only with --size; needs FreeCAD) instead of the FEM path, which meshes "
                         "the CAD surface itself at the size (default; automatic size: the "
                         "bounding-box diagonal / 20)")
-    m.add_argument("--on-cad", action="store_true",
-                   help="CAD input: mesh as the FreeCAD mesher does (needs FreeCAD): boundary "
-                        "points the refinement adds and tet10 mid-nodes go onto the CAD faces and "
-                        "edges (OpenCASCADE), so the mesh follows the curved surface; without it "
-                        "they stay on the tessellation's flat triangles")
-    m.add_argument("--no-straighten-midnodes", action="store_true",
-                   help="with --on-cad and --order 2: stop with the error where curved mid-nodes "
-                        "still invert elements after every mend, instead of pulling those "
-                        "mid-nodes towards their straight edges (a valid mesh, with a note on how "
-                        "many boundary mid-nodes are how far off the CAD)")
     m.add_argument("--compare-tetgen", action="store_true",
                    help="also run tetgen -pY on the same surface and print both side by side")
     m.add_argument("--reorient", action="store_true",

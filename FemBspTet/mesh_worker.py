@@ -15,9 +15,10 @@ Worker side: ``<python> -m FemBspTet.mesh_worker JOB_DIR`` with the checkout on 
 Job directory protocol (a private temporary directory, removed by the client):
 
 * ``shape.brep``: the shape to mesh as BREP text (``Shape.exportBrepToString``; BREP keeps
-  the topology, so ``Faces`` come back in the same order, and ``face_count`` in the parameters
-  is checked). In-process runs mesh the same BREP copy (``mesh_pipeline.brep_copy``), so both
-  give identical meshes.
+  the topology, so the faces keep their order, and ``face_count`` in the parameters is checked
+  against the faces the FEM path reads). In-process runs mesh the same BREP text
+  (``mesh_pipeline.mesh_cad_shape``), so both give identical meshes. The worker starts FreeCAD
+  only for the TetGen comparison (it tessellates the shape).
 * ``parameters.json``: ``{"parameters": MeshParameters.to_dict(), "face_count": n,
   "source": label}``.
 * stdout lines ``PROGRESS <fraction or -> <stage text>`` while it runs.
@@ -61,7 +62,7 @@ _ERROR_TYPES = {"InputError": InputError, "InternalError": InternalError,
 def write_job(job_dir, shape, params, source=""):
     """Write the job files for ``shape`` and ``params`` into ``job_dir``."""
     with open(os.path.join(job_dir, "shape.brep"), "w", encoding="utf-8") as f:
-        f.write(shape.exportBrepToString())  # what mesh_pipeline.brep_copy reads, too
+        f.write(shape.exportBrepToString())  # what mesh_pipeline.mesh_cad_shape meshes, too
     with open(os.path.join(job_dir, "parameters.json"), "w", encoding="utf-8") as f:
         json.dump({"parameters": params.to_dict(), "face_count": len(shape.Faces),
                    "source": source}, f)
@@ -210,22 +211,15 @@ def main(argv=None):
         sys.stdout.flush()
 
     try:
-        from .freecad_env import import_freecad
-        from .mesh_pipeline import MeshParameters, mesh_cad_shape
+        from .mesh_pipeline import MeshParameters, mesh_brep
 
         with open(os.path.join(job_dir, "parameters.json"), encoding="utf-8") as f:
             job = json.load(f)
         params = MeshParameters.from_dict(job["parameters"])
-        progress("starting FreeCAD", None)
-        import_freecad()
-        import Part
-
-        shape = Part.read(os.path.join(job_dir, "shape.brep"))
-        if len(shape.Faces) != job["face_count"]:
-            raise InternalError("the shape came back from BREP with %d faces instead of %d"
-                                % (len(shape.Faces), job["face_count"]))
-        result = mesh_cad_shape(shape, params, progress=progress, source=job.get("source", ""),
-                                shape_is_brep_copy=True)
+        with open(os.path.join(job_dir, "shape.brep"), encoding="utf-8") as f:
+            brep = f.read()
+        result = mesh_brep(brep, job["face_count"], params, progress=progress,
+                           source=job.get("source", ""))
         result.save(os.path.join(job_dir, "result.npz"), os.path.join(job_dir, "result.json"))
         return 0
     except Exception as e:  # reported to the client through error.json

@@ -10,11 +10,15 @@
 * ``Part`` (App::PropertyLink): the solid the mesh is made from. FEM's writers read
   ``mesh_obj.Part`` when there is no ``Shape``.
 * Parameters mean what FemMeshGmsh's mean where the names are the same
-  (``CharacteristicLengthMax``/``Min``: 0 = automatic/none; ``ElementOrder`` "1st"/"2nd").
+  (``CharacteristicLengthMax``/``Min``: 0 = automatic; ``ElementOrder`` "1st"/"2nd").
 * Results (read-only in the property editor) are set by ``mesher_tools.apply_result``.
 * Saved files store ``module="FemBspTet.mesher_object" class="MeshBspTet"``: never rename them.
   Properties are added only if missing, from ``__init__`` and from ``onDocumentRestored`` (files
-  of older versions gain new properties with their defaults).
+  of older versions gain new properties with their defaults). The parameters of the former
+  tessellation pipeline (``LinearDeflection``, ``AngularDeflection``, ``QualityBound``,
+  ``ThicknessRatio``, ``AllowBoundarySteiner``, ``RemeshSurface``, ``StraightenMidNodes``) are
+  removed from restored objects: FreeCAD restores dynamic properties from the file whether or
+  not the proxy knows them, so the files open as before, and nothing reads those values.
 """
 
 from .errors import InputError
@@ -31,39 +35,18 @@ RESULTS_GROUP = "BspTet Mesh Results"
 PARAMETER_PROPERTIES = (
     ("App::PropertyLink", "Part", "FEM Mesh", "The solid (Part) the mesh is made from", None),
     ("App::PropertyLength", "CharacteristicLengthMax", PARAMS_GROUP,
-     "Maximum element size (0 = automatic: the bounding-box diagonal / 20 when RemeshSurface "
-     "is on; without it the tessellation is filled as it is)", 0.0),
+     "Largest element size (0 = automatic: the bounding-box diagonal / 20). Curved faces and "
+     "edges get smaller elements (12 per full circle)", 0.0),
     ("App::PropertyLength", "CharacteristicLengthMin", PARAMS_GROUP,
-     "Minimum element size (0 = none). Needs the core's quality stage", 0.0),
+     "Smallest element size (0 = automatic: CharacteristicLengthMax / 50)", 0.0),
     ("App::PropertyEnumeration", "ElementOrder", PARAMS_GROUP,
      "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
      ("1st", "2nd")),
-    ("App::PropertyLength", "LinearDeflection", PARAMS_GROUP,
-     "Largest distance between the surface triangles and the CAD faces (0 = automatic: "
-     "min(h/10, diagonal/200) with a maximum size h, else diagonal/500)", 0.0),
-    ("App::PropertyAngle", "AngularDeflection", PARAMS_GROUP,
-     "Largest angle between the normals of neighbouring surface triangles", 28.64788975654116),
-    ("App::PropertyFloat", "QualityBound", PARAMS_GROUP,
-     "Radius-edge ratio bound of quality refinement (0 = off; e.g. 1.414). Needs the core's "
-     "quality stage", 0.0),
-    ("App::PropertyFloat", "ThicknessRatio", PARAMS_GROUP,
-     "Thin walls: the element size on a face is at most this times the solid's local thickness "
-     "there (0 = off). Tets of the full size across a much thinner wall are flat", 4.0),
-    ("App::PropertyBool", "AllowBoundarySteiner", PARAMS_GROUP,
-     "Allow Steiner points on the surface (placed on the CAD faces)", False),
     ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
      "Make a node group per CAD face (BspTet_Face1, ...)", False),
     ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
-     "Also run tetgen -pY on the same surface and show its counts", True),
-    ("App::PropertyBool", "RemeshSurface", PARAMS_GROUP,
-     "Remesh each CAD face's tessellation towards the element size (well-shaped triangles on "
-     "the CAD faces, as Gmsh and Netgen do) before the volume mesh. Better shaped tets, "
-     "slower, more tets", False),
-    ("App::PropertyBool", "StraightenMidNodes", PARAMS_GROUP,
-     "2nd order: where the curved mid-nodes still invert elements after every mend, pull them "
-     "towards their straight edges (a valid mesh; those boundary mid-nodes are then off the CAD "
-     "face by up to the chord sag, and a note says how many and how far) instead of stopping "
-     "with an error", True),
+     "Also run tetgen -pY on OpenCASCADE's display tessellation of the part and show its "
+     "counts", True),
 )
 
 #: (type, name, tooltip) of every read-only result property.
@@ -71,15 +54,19 @@ RESULT_PROPERTIES = (
     ("App::PropertyString", "MeshStatus", "Outcome of the last meshing run"),
     ("App::PropertyInteger", "Nodes", "Nodes of the mesh"),
     ("App::PropertyInteger", "Tetrahedra", "Tetrahedra of the mesh"),
-    ("App::PropertyInteger", "SteinerPoints", "Points the mesher added to the surface vertices"),
-    ("App::PropertyInteger", "BoundarySteinerPoints", "Steiner points on the surface"),
+    ("App::PropertyInteger", "SteinerPoints",
+     "Corner nodes the volume mesher added to the CAD surface mesh's nodes"),
+    ("App::PropertyInteger", "BoundarySteinerPoints",
+     "Of those, the ones on the CAD faces (refinement of the surface)"),
     ("App::PropertyFloat", "MinDihedralAngle", "Smallest dihedral angle (degrees)"),
     ("App::PropertyFloat", "MaxRadiusEdgeRatio", "Largest radius-edge ratio"),
-    ("App::PropertyFloat", "MeshingTime", "Seconds of the last run (tessellation to FemMesh)"),
+    ("App::PropertyFloat", "MeshingTime", "Seconds of the last run (CAD to mesh)"),
     ("App::PropertyStringList", "MeshNotes", "What the mesher could not do as asked, warnings"),
-    ("App::PropertyString", "TetGenCommand", "The TetGen run of the comparison"),
-    ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the same surface"),
-    ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the same surface"),
+    ("App::PropertyString", "TetGenCommand",
+     "The TetGen run of the comparison (on OpenCASCADE's display tessellation)"),
+    ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the display tessellation"),
+    ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the display "
+     "tessellation"),
     ("App::PropertyInteger", "TetGenSteinerPoints", "TetGen's Steiner points"),
     ("App::PropertyInteger", "TetGenBoundarySteinerPoints", "TetGen's Steiner points on the "
      "surface"),
@@ -107,7 +94,15 @@ ROW_PROPERTIES = {
 
 
 def add_properties(obj):
-    """Add every missing property of the mesher object (also used to upgrade old files)."""
+    """Add every missing property of the mesher object, and remove the parameters of the
+    former tessellation pipeline (``mesh_pipeline.REMOVED_PARAMETERS``) from objects of older
+    files, saying so on the console. Used on creation and to upgrade restored objects. Returns
+    the names removed."""
+    from .mesh_pipeline import REMOVED_PARAMETERS
+
+    removed = [name for name in REMOVED_PARAMETERS.values() if name in obj.PropertiesList]
+    for name in removed:
+        obj.removeProperty(name)
     existing = set(obj.PropertiesList)
     for kind, name, group, tip, default in PARAMETER_PROPERTIES:
         if name in existing:
@@ -122,6 +117,7 @@ def add_properties(obj):
         if name not in existing:
             obj.addProperty(kind, name, RESULTS_GROUP, tip)
         obj.setEditorMode(name, 1)  # read-only in the property editor
+    return removed
 
 
 class StatelessProxy:
@@ -151,7 +147,15 @@ class MeshBspTet(StatelessProxy):
         add_properties(obj)
 
     def onDocumentRestored(self, obj):
-        add_properties(obj)
+        removed = add_properties(obj)
+        if removed:
+            import FreeCAD
+
+            from .mesh_pipeline import REMOVED_BECAUSE
+
+            FreeCAD.Console.PrintMessage(
+                "FemBspTet: %s: removed the former mesher properties %s (%s)\n"
+                % (obj.Label, ", ".join(removed), REMOVED_BECAUSE.split(";")[0]))
 
     def execute(self, obj):
         """Recompute never meshes (as FEM's Gmsh object): meshing is an explicit action."""
@@ -180,7 +184,12 @@ def make_mesher(doc, part=None, name="MeshBspTet", **properties):
     freecad = import_freecad()
     import Fem  # noqa: F401  (registers the Fem:: document object types)
 
+    from .mesh_pipeline import REMOVED_PARAMETERS, removed_parameter_message
+
     known = {p[1] for p in PARAMETER_PROPERTIES}
+    removed = set(properties) & set(REMOVED_PARAMETERS.values())
+    if removed:
+        raise InputError("mesher property: " + removed_parameter_message(removed))
     unknown = set(properties) - known
     if unknown:
         raise InputError("unknown mesher propert%s %s; the parameters are %s"

@@ -10,10 +10,9 @@ went wrong. The task panel runs the same pipeline in a worker process
 (:mod:`FemBspTet.mesh_worker`) and hands the result to :func:`apply_result` on the GUI thread.
 """
 
-import math
-
 from .errors import InputError
-from .mesh_pipeline import PROPERTY_OF, MeshParameters, mesh_cad_shape
+from .mesh_pipeline import (PROPERTY_OF, REMOVED_PARAMETERS, MeshParameters, mesh_cad_shape,
+                            removed_parameter_message)
 
 #: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
 EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
@@ -25,15 +24,8 @@ def parameters_from_object(obj):
         max_size=float(obj.CharacteristicLengthMax.Value),
         min_size=float(obj.CharacteristicLengthMin.Value),
         order=1 if obj.ElementOrder == "1st" else 2,
-        linear_deflection=float(obj.LinearDeflection.Value),
-        angular_deflection=math.radians(float(obj.AngularDeflection.Value)),
-        quality_bound=float(obj.QualityBound),
-        thickness_ratio=float(getattr(obj, "ThicknessRatio", 4.0)),
-        allow_boundary_steiner=bool(obj.AllowBoundarySteiner),
         face_groups=bool(obj.FaceGroups),
         compare_tetgen=bool(obj.CompareWithTetGen),
-        remesh_surface=bool(getattr(obj, "RemeshSurface", False)),
-        straighten_midnodes=bool(getattr(obj, "StraightenMidNodes", True)),
     ).validate()
 
 
@@ -126,21 +118,22 @@ def set_tetgen_properties(obj, row):
 def mesh_shape(shape, **options):
     """Mesh a ``Part.Shape`` and return a ``Fem.FemMesh`` (SMESH conventions).
 
-    options: MeshParameters fields (``max_size``, ``min_size``, ``order``,
-    ``linear_deflection``, ``angular_deflection`` in radians, ``quality_bound``,
-    ``thickness_ratio``, ``allow_boundary_steiner``, ``face_groups``, ``remesh_surface``,
-    ``straighten_midnodes``) or the object's property names
-    (``CharacteristicLengthMax``, ``ElementOrder`` "1st"/"2nd", ``AngularDeflection`` in
-    degrees, ...). Raises InputError / InternalError with a message.
+    options: MeshParameters fields (``max_size``, ``min_size``, ``order``, ``face_groups``) or
+    the object's property names (``CharacteristicLengthMax``, ``CharacteristicLengthMin``,
+    ``ElementOrder`` "1st"/"2nd", ``FaceGroups``). The former tessellation options
+    (``LinearDeflection``, ``RemeshSurface``, ...) are refused with the reason. Raises
+    InputError / InternalError with a message.
     """
     params = MeshParameters(compare_tetgen=False).to_dict()
     field_of = {prop: field for field, prop in PROPERTY_OF.items()}
+    field_of.update({prop: field for field, prop in REMOVED_PARAMETERS.items()})
+    removed = [key for key in options if field_of.get(key, key) in REMOVED_PARAMETERS]
+    if removed:
+        raise InputError(removed_parameter_message(removed))
     for key, value in options.items():
         field = field_of.get(key, key)
         if key == "ElementOrder":
             value = {"1st": 1, "2nd": 2}.get(value, value)
-        if key == "AngularDeflection":
-            value = math.radians(float(value))
         params[field] = value
     params = MeshParameters.from_dict(params)
     result = mesh_cad_shape(shape, params)

@@ -12,8 +12,6 @@ PARAM_PATH = "User parameter:BaseApp/Preferences/Mod/Fem/BspTet"
 #: Interpreter of the worker process when the preference is empty: Debian's, the one FreeCAD's
 #: Python modules load in (inside the GUI ``sys.executable`` is ``/usr/bin/freecad``).
 DEFAULT_WORKER_PYTHON = "/usr/bin/python3"
-#: OCCT's default angular deflection, 0.5 rad, in degrees.
-DEFAULT_ANGULAR_DEFLECTION_DEG = 28.64788975654116
 
 
 def _group():
@@ -27,11 +25,8 @@ def object_defaults():
     g = _group()
     return {
         "ElementOrder": "1st" if g.GetInt("ElementOrder", 1) == 0 else "2nd",
-        "AngularDeflection": g.GetFloat("AngularDeflection", DEFAULT_ANGULAR_DEFLECTION_DEG),
         "CompareWithTetGen": g.GetBool("CompareWithTetGen", True),
         "FaceGroups": g.GetBool("FaceGroups", False),
-        "AllowBoundarySteiner": g.GetBool("AllowBoundarySteiner", False),
-        "RemeshSurface": g.GetBool("RemeshSurface", False),
     }
 
 

@@ -46,43 +46,19 @@ class TaskPanelMeshBspTet:
 
         params = QtGui.QGroupBox("Parameters")
         grid = QtGui.QFormLayout(params)
-        self.sb_max = self._length_box(grid, "Max element size", "0 = automatic", "automatic")
-        self.sb_min = self._length_box(grid, "Min element size", "0 = none (quality stage)",
-                                       "none")
+        self.sb_max = self._length_box(
+            grid, "Max element size", "0 = automatic: the bounding-box diagonal / 20; curved "
+            "faces and edges get smaller elements", "automatic")
+        self.sb_min = self._length_box(grid, "Min element size",
+                                       "0 = automatic: the max element size / 50", "automatic")
         self.cb_order = QtGui.QComboBox()
         self.cb_order.addItems(["1st", "2nd"])
         grid.addRow("Element order", self.cb_order)
-        self.sb_deflection = self._length_box(grid, "Linear deflection", "0 = automatic",
-                                              "automatic")
-        self.sb_angle = QtGui.QDoubleSpinBox()
-        self.sb_angle.setRange(0.1, 179.0)
-        self.sb_angle.setDecimals(2)
-        self.sb_angle.setSuffix(" °")
-        grid.addRow("Angular deflection", self.sb_angle)
-        self.sb_quality = QtGui.QDoubleSpinBox()
-        self.sb_quality.setRange(0.0, 100.0)
-        self.sb_quality.setDecimals(3)
-        self.sb_quality.setSpecialValueText("off")
-        grid.addRow("Radius-edge bound", self.sb_quality)
-        self.sb_thickness = QtGui.QDoubleSpinBox()
-        self.sb_thickness.setRange(0.0, 100.0)
-        self.sb_thickness.setDecimals(2)
-        self.sb_thickness.setSpecialValueText("off")
-        self.sb_thickness.setToolTip("Thin walls: the element size on a face is at most this "
-                                     "times the solid's local thickness there")
-        grid.addRow("Thin-wall ratio", self.sb_thickness)
-        self.ck_boundary = QtGui.QCheckBox("Allow Steiner points on the surface")
         self.ck_groups = QtGui.QCheckBox("Node group per CAD face")
         self.ck_tetgen = QtGui.QCheckBox("Compare with tetgen -pY")
-        self.ck_remesh = QtGui.QCheckBox("Remesh the CAD faces to the element size")
-        self.ck_straighten = QtGui.QCheckBox("2nd order: straighten mid-nodes that would "
-                                             "invert elements")
-        self.ck_straighten.setToolTip(
-            "Where the curved mid-nodes still invert elements after every mend, pull them "
-            "towards their straight edges (a note says how many and how far off the CAD they "
-            "are) instead of stopping with an error")
-        for ck in (self.ck_boundary, self.ck_groups, self.ck_tetgen, self.ck_remesh,
-                   self.ck_straighten):
+        self.ck_tetgen.setToolTip("tetgen -pY on OpenCASCADE's display tessellation of the part "
+                                  "(our mesh is made from the CAD faces themselves)")
+        for ck in (self.ck_groups, self.ck_tetgen):
             grid.addRow(ck)
         layout.addWidget(params)
 
@@ -140,33 +116,16 @@ class TaskPanelMeshBspTet:
         self.sb_max.setValue(o.CharacteristicLengthMax.Value)
         self.sb_min.setValue(o.CharacteristicLengthMin.Value)
         self.cb_order.setCurrentIndex(0 if o.ElementOrder == "1st" else 1)
-        self.sb_deflection.setValue(o.LinearDeflection.Value)
-        self.sb_angle.setValue(o.AngularDeflection.Value)
-        self.sb_quality.setValue(o.QualityBound)
-        self.sb_thickness.setValue(float(getattr(o, "ThicknessRatio", 4.0)))
-        self.ck_boundary.setChecked(bool(o.AllowBoundarySteiner))
         self.ck_groups.setChecked(bool(o.FaceGroups))
         self.ck_tetgen.setChecked(bool(o.CompareWithTetGen))
-        self.ck_remesh.setChecked(bool(getattr(o, "RemeshSurface", False)))
-        self.ck_straighten.setChecked(bool(getattr(o, "StraightenMidNodes", True)))
 
     def store_parameters(self):
         o = self.obj
         o.CharacteristicLengthMax = self.sb_max.value()
         o.CharacteristicLengthMin = self.sb_min.value()
         o.ElementOrder = self.cb_order.currentText()
-        o.LinearDeflection = self.sb_deflection.value()
-        o.AngularDeflection = self.sb_angle.value()
-        o.QualityBound = self.sb_quality.value()
-        if hasattr(o, "ThicknessRatio"):
-            o.ThicknessRatio = self.sb_thickness.value()
-        o.AllowBoundarySteiner = self.ck_boundary.isChecked()
         o.FaceGroups = self.ck_groups.isChecked()
         o.CompareWithTetGen = self.ck_tetgen.isChecked()
-        if hasattr(o, "RemeshSurface"):
-            o.RemeshSurface = self.ck_remesh.isChecked()
-        if hasattr(o, "StraightenMidNodes"):
-            o.StraightenMidNodes = self.ck_straighten.isChecked()
 
     # ---------------------------------------------------------------- task dialog API
 

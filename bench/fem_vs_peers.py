@@ -1044,7 +1044,7 @@ def parse_args(argv):
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "docs", "benchmarks"),
                     help="where %s.md and the pictures go" % REPORT_STEM)
     ap.add_argument("--ours-args", default="", metavar="ARGS",
-                    help="more flags for our CLI, e.g. --ours-args=--on-cad")
+                    help="more flags for our CLI, e.g. --ours-args=--tessellation")
     ap.add_argument("--json", default=None, help="also write the figures here")
     ap.add_argument("--workdir", default=None, help="keep the meshes and logs here")
     args = ap.parse_args(argv)

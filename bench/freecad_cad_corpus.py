@@ -1,10 +1,10 @@
 #!/usr/bin/python3
-"""Every CAD file of a folder through the FreeCAD mesher pipeline, each in a worker process with a
-time limit: either a mesh (nodes, tets, seconds, boundary nodes put on the CAD) or the message the
-user would see. Usage:
+"""Every CAD file of a folder through the FreeCAD mesher pipeline (the FEM path), each in a worker
+process with a time limit: either a mesh (nodes, tets, seconds) or the message the user would see.
+Usage:
 
     bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--size-of-diagonal F]
-                                [--timeout S] [--markdown F] [--remesh-surface]
+                                [--timeout S] [--markdown F]
 
 Default folder: tests/data/cad. Prints one row per file.
 """
@@ -34,8 +34,6 @@ def main():
     ap.add_argument("--size-of-diagonal", type=float, default=0.0, metavar="F",
                     help="CharacteristicLengthMax = F * the shape's bounding-box diagonal "
                          "(default 0: automatic, the mesher object's default)")
-    ap.add_argument("--remesh-surface", action="store_true",
-                    help="RemeshSurface on (FemBspTet.surface_remesh; default off, as the object)")
     args = ap.parse_args()
     import_freecad()
     import Part
@@ -52,8 +50,7 @@ def main():
             print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
         size = args.size_of_diagonal * shape.BoundBox.DiagonalLength
-        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False,
-                                              remesh_surface=args.remesh_surface),
+        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False),
                       source=name, python="/usr/bin/python3")
         job.start()
         if not job.wait(args.timeout):

@@ -101,6 +101,10 @@ try:
 
         obj = state["obj"]
         obj.ElementOrder = "1st"
+        # a coarse mesh: FreeCAD 0.20.2's offscreen Coin3D crashes (SIGSEGV in
+        # QuarterWidgetP::removeFromCacheContext) when a closed document's view held a mesh of
+        # a few thousand tets (3,646 at the automatic size), in the save-and-reload step
+        obj.CharacteristicLengthMax = 10
         FreeCADGui.ActiveDocument.setEdit(obj.Name)
         tp = obj.ViewObject.Proxy.task_panel
         facts["panel_is_ours"] = isinstance(tp, TaskPanelMeshBspTet)
@@ -130,7 +134,7 @@ try:
     def _():
         obj, tp = state["obj"], state["panel"]
         before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.MeshStatus)
-        tp.sb_deflection.setValue(0.05)  # another mesh, were it kept
+        tp.sb_max.setValue(1.5)  # another mesh, were it kept
         facts["restart_started"] = tp.start_meshing()
         job = tp.job
         facts["running_before_stop"] = tp.running
@@ -150,7 +154,7 @@ try:
         doc.recompute()
         before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount)
         obj.Part = shell
-        tp.sb_deflection.setValue(0.0)
+        tp.sb_max.setValue(0.0)
         tp.start_meshing()
         tp.wait(120)
         facts["failure_error"] = str(tp.last_error)
@@ -198,8 +202,9 @@ try:
         ui = os.path.join(os.path.dirname(os.path.dirname(FemBspTet.__file__)), "resources",
                           "ui", "PreferencesBspTet.ui")
         w = FreeCADGui.PySideUic.loadUi(ui)
-        sb = w.findChild(QtGui.QDoubleSpinBox, "sb_angular_deflection")
-        facts["prefs_spinbox_class"] = sb.metaObject().className() if sb else None
+        cb = w.findChild(QtGui.QComboBox, "cb_order")
+        facts["prefs_combobox_class"] = cb.metaObject().className() if cb else None
+        facts["prefs_checkboxes"] = sorted(c.objectName() for c in w.findChildren(QtGui.QCheckBox))
 except Exception:
     facts["errors"].append("session: " + traceback.format_exc())
 finally:

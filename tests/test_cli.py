@@ -278,8 +278,6 @@ def test_mesh_bsp_seed_picks_where_the_bsp_starts(cli, tmp_path):
 def _boundary_nodes_off_cad(mesh, shape):
     """Largest distance from a boundary node (corners and tet10 mid-nodes of boundary faces) to
     the CAD shape's faces."""
-    import numpy as np
-
     import Part
     from FemBspTet.mesh_pipeline import boundary_faces_of, boundary_midnodes
 
@@ -297,10 +295,10 @@ def _boundary_nodes_off_cad(mesh, shape):
     return worst
 
 
-def test_mesh_on_cad_puts_tet10_mid_nodes_on_the_cad(cli, tmp_path):
-    """``--on-cad``: the FreeCAD mesher's pipeline from the command line; every boundary node of
-    the tet10 mesh lies on the CAD (the plain run leaves mid-nodes on the chords of the
-    cylinder, a chord sag away)."""
+def test_mesh_cad_puts_tet10_mid_nodes_on_the_cad(cli, tmp_path):
+    """A CAD file is meshed by the FEM path: every boundary node of the tet10 mesh (corners and
+    mid-nodes, the cylinder's included) lies on the CAD; ``--tessellation`` fills the display
+    tessellation with the core instead, its mid-nodes on the chords of the cylinder."""
     from FemBspTet.freecad_env import freecad_available, import_freecad
 
     if not freecad_available():
@@ -314,34 +312,24 @@ def test_mesh_on_cad_puts_tet10_mid_nodes_on_the_cad(cli, tmp_path):
     cad = os.path.join(root, "tests", "data", "cad", "red_cube_blue_cylinder.step")
     shape = Part.read(cad)
     off = {}
-    for flag in ("--on-cad", None):
-        out = tmp_path / ("on.vtu" if flag else "plain.vtu")
+    for flag in (None, "--tessellation"):
+        out = tmp_path / ("tess.vtu" if flag else "fem.vtu")
         args = ["mesh", cad, "-o", out, "--order", "2", "--quiet"] + ([flag] if flag else [])
         r = run(cli, *args)
         assert r.returncode == 0, r.stderr
         mesh = read_tet_mesh(str(out))
         assert mesh.tets.shape[1] == 10
         off[flag] = _boundary_nodes_off_cad(mesh, shape)
-    # Both put boundary nodes on the CAD: --on-cad through FreeCAD, the default (the FEM path)
-    # through its own OpenCASCADE layer.
-    assert off["--on-cad"] < 1e-6
     assert off[None] < 1e-6
+    assert off["--tessellation"] > 1e-3  # chord sag of the cylinder's tessellation
 
 
-def test_mesh_on_cad_refuses_a_surface_file_and_core_only_options(cli, tmp_path):
-    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "x.vtu", "--on-cad")
-    assert r.returncode == 2 and "--on-cad needs a CAD file" in r.stderr
+def test_mesh_refuses_the_former_on_cad_flags(cli, tmp_path):
+    """``--on-cad`` and ``--no-straighten-midnodes`` are gone (the FEM path is the default for
+    CAD files): argparse refuses them with exit 2 and no file is written."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     cad = os.path.join(root, "tests", "data", "cad", "red_cube_blue_cylinder.step")
-    r = run(cli, "mesh", cad, "-o", tmp_path / "x.vtu", "--on-cad", "--reorient")
-    assert r.returncode == 2 and "--reorient" in r.stderr
-    assert not (tmp_path / "x.vtu").exists()
-
-
-def test_no_straighten_midnodes_is_refused_without_on_cad(cli, tmp_path):
-    """The flag belongs to the FreeCAD pipeline's curved tet10 (``--on-cad``): elsewhere it is
-    refused with the reason, and no file is written."""
-    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "x.vtu", "--order", "2",
-            "--no-straighten-midnodes")
-    assert r.returncode == 2 and "--no-straighten-midnodes is for --on-cad" in r.stderr
+    for flag in ("--on-cad", "--no-straighten-midnodes"):
+        r = run(cli, "mesh", cad, "-o", tmp_path / "x.vtu", flag)
+        assert r.returncode == 2 and "unrecognized arguments: " + flag in r.stderr
     assert not (tmp_path / "x.vtu").exists()

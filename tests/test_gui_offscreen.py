@@ -109,7 +109,7 @@ def test_stop_kills_the_worker_and_keeps_the_mesh(facts):
 
 
 def test_failure_keeps_the_mesh_and_says_why(facts):
-    assert "not a solid" in facts["failure_error"] and "Face1" in facts["failure_error"]
+    assert "holds no solid (1 shell(s), 5 face(s))" in facts["failure_error"]
     assert facts["failure_status_property"].startswith("failed: ")
     assert facts["mesh_kept_after_failure"] is True
     assert "meshing MeshBspTet failed" in facts["_log"]
@@ -130,4 +130,5 @@ def test_save_and_reload_with_the_mesh(facts):
 
 
 def test_preferences_page_loads(facts):
-    assert facts["prefs_spinbox_class"] == "Gui::PrefDoubleSpinBox"
+    assert facts["prefs_combobox_class"] == "Gui::PrefComboBox"
+    assert facts["prefs_checkboxes"] == ["ck_compare_tetgen", "ck_face_groups"]

@@ -1,4 +1,4 @@
-"""Fins of a CAD tessellation (FemBspTet.surface_remesh.flip_out_fins): a near-collinear triangle
+"""Fins of a CAD tessellation (FemBspTet.cad_tessellation.flip_out_fins): a near-collinear triangle
 along a CAD edge is flipped away inside its face, nothing else changes, and the flat tet it forced
 goes with it.
 
@@ -6,14 +6,14 @@ The solid is a unit cube, placed off the origin, whose bottom face (tag 0) and f
 share the edge from corner 0 to corner 1 with one more point b on it, as OpenCASCADE's edge
 discretization puts points there. The bottom face's triangulation has the fin (0, 1, b): b lies
 in the front face's plane, 1e-7 above the bottom's, so the fin is a real triangle of almost no
-area. The meshes go through the quality stage as the FreeCAD pipeline's do (separate_face_tags).
+area. The meshes go through the core with separate_face_tags.
 """
 
 import numpy as np
 
 from FemBspTet import core
+from FemBspTet.cad_tessellation import flip_out_fins
 from FemBspTet.mesh_types import Surface
-from FemBspTet.surface_remesh import flip_out_fins
 
 OFFSET = np.array([103.5, -7.25, 11.0])
 
@@ -100,7 +100,8 @@ def test_a_fin_whose_long_edge_borders_another_face_is_left():
 
 
 def test_the_command_line_flips_the_fins_of_a_cad_file():
-    """`fembsptet mesh part.step` reads CAD files through cli.load_input: OpenCASCADE's bottle
+    """`fembsptet mesh --tessellation part.step` (and `compare`) read CAD files through
+    cli.load_input: OpenCASCADE's bottle
     has 12 fins, the surface it meshes only those no flip can mend, with the same vertices."""
     import os
 
