@@ -21,8 +21,7 @@ from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
 from .mesh_types import Surface, TetMesh
 
 
-#: End of the note on tet10 mid-nodes the core left on their chords (after the count). The FreeCAD
-#: pipeline, which puts every boundary mid-node on the CAD afterwards, leaves it out.
+#: End of the note on tet10 mid-nodes the core left on their chords (after the count).
 MIDNODES_STRAIGHTENED_NOTE = ("curved mid-nodes were put back on their chord (the curved tet would "
                               "not have been valid)")
 
@@ -511,8 +510,7 @@ REFINE_OPTIONS = {
                           "membership (FreeCAD's CalculiX writer) load exactly the boundary faces",
 }
 
-#: Every option name :func:`tetrahedralize` accepts (the FreeCAD pipeline maps its properties
-#: onto these, ``mesh_pipeline.CORE_OPTION_OF``).
+#: Every option name :func:`tetrahedralize` accepts.
 OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "bsp_seed", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
 
 
