@@ -223,7 +223,10 @@ def main(argv=None):
         result.save(os.path.join(job_dir, "result.npz"), os.path.join(job_dir, "result.json"))
         return 0
     except Exception as e:  # reported to the client through error.json
-        kind = type(e).__name__ if type(e).__name__ in _ERROR_TYPES else "InternalError"
+        # subclasses (SelfIntersectionError, ...) travel as their base type
+        kind = type(e).__name__ if type(e).__name__ in _ERROR_TYPES else next(
+            (name for name in ("InputError", "MeshingCancelled")
+             if isinstance(e, _ERROR_TYPES[name])), "InternalError")
         message = str(e) if kind != "InternalError" or isinstance(e, InternalError) else \
             "unexpected %s: %s\n%s" % (type(e).__name__, e, traceback.format_exc())
         with open(os.path.join(job_dir, "error.json"), "w", encoding="utf-8") as f:

@@ -221,7 +221,7 @@ def test_mesh_cad_solid_is_valid(cli, tmp_path, cad):
 
 
 def test_mesh_bottle_tessellation_is_valid(cli, tmp_path):
-    """bottle.brep as the FreeCAD mesher tessellates it: the core used to stop with "could not move
+    """bottle.brep as the former FreeCAD tessellation pipeline tessellated it: the core used to stop with "could not move
     the surface Steiner point ... inside the solid" (interior points left ulps from the surface
     closed the point's kernel; steiner_removal.h, PUSH). Needs no FreeCAD."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
