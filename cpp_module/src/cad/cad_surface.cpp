@@ -388,6 +388,7 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
     }
     for (const Vec3& p : fm.new_xyz) add_node(gp_Pnt(p.x, p.y, p.z), 2, f);
     st.folds += fm.folds;
+    if (fm.folds > 0) st.folded_faces.emplace_back(f, fm.folds);
     st.min_quality = std::min(st.min_quality, fm.min_quality);
     face_tris[f] = std::move(fm.triangles);
     progress("faces", double(f + 1) / n_faces);

@@ -371,13 +371,26 @@ int FaceMesher::collapse_pass() {
   return done;
 }
 
+/// Lawson's order: every edge once, then the four outer edges of each flipped quad again, until
+/// no flip raises a quality (each flip raises the worse of its two triangles, so this ends; a
+/// cap of 50 flips per triangle bounds it anyway). A fan of needles across a long thin face
+/// unwinds in one pass this way, where sweeps over all edges would need one sweep per step.
 int FaceMesher::flip_pass() {
+  std::vector<std::pair<int, int>> stack = interior_edges();
+  std::reverse(stack.begin(), stack.end());  // pop in sorted order first
+  const std::size_t cap = 50 * tris_.size() + 1000;
   int total = 0;
-  for (int sweep = 0; sweep < 32; ++sweep) {
-    int done = 0;
-    for (const auto& [a, b] : interior_edges()) done += flip(a, b) ? 1 : 0;
-    total += done;
-    if (done == 0) break;
+  while (!stack.empty() && static_cast<std::size_t>(total) < cap) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const auto [t0, t1] = edge_tris(a, b);
+    if (t0 < 0 || t1 < 0) continue;
+    const int c = opposite(tris_[static_cast<std::size_t>(t0)], a, b);
+    const int d = opposite(tris_[static_cast<std::size_t>(t1)], a, b);
+    if (!flip(a, b)) continue;
+    ++total;
+    for (const auto& e : {std::make_pair(a, c), std::make_pair(c, b), std::make_pair(b, d), std::make_pair(d, a)})
+      stack.push_back(e);
   }
   return total;
 }
@@ -438,7 +451,10 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
       const double s = count ? sum / count : kInf;
       ids.push_back(static_cast<int>(verts_.size()));
       const bool pole = loop[(i + n - 1) % n].node == b.node || loop[(i + 1) % n].node == b.node;
-      verts_.push_back({b.uv, b.xyz, b.node, true, pole, std::isfinite(s) ? s : options_.face_size, normal(b.uv)});
+      // A pole has no normal of its own: evaluated at its (u, v), rounding may even put it on
+      // the far side of a cone's apex, where the normal is reversed.
+      verts_.push_back({b.uv, b.xyz, b.node, true, pole, std::isfinite(s) ? s : options_.face_size,
+                        pole ? Vec3{0, 0, 0} : normal(b.uv)});
       vt_.emplace_back();
       uv.push_back(b.uv);
       if (std::isfinite(s)) boundary_sizes_.emplace_back(b.xyz, s);

@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include <BRepAdaptor_Curve.hxx>
+#include <BRepGProp.hxx>
+#include <GProp_GProps.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepLProp_CLProps.hxx>
 #include <BRepLProp_SLProps.hxx>
@@ -21,6 +23,7 @@ namespace {
 
 constexpr double kTwoPi = 6.283185307179586;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNarrowFaceFactor = 2;
 
 void check_option(double value, const char* name) {
   if (!std::isfinite(value) || value < 0) {
@@ -65,6 +68,15 @@ SizeField::SizeField(const CadModel& model, const SizeOptions& options) {
     double s = size_;
     const auto it = options.size_by_face.find(f);
     if (it != options.size_by_face.end() && it->second > 0) s = std::min(s, it->second);
+    // Narrow faces (a thread's flank, a small fillet or chamfer strip): at most twice the face's
+    // mean width 2 A / P, so that its triangles span the width in one or two steps instead of
+    // needles across a twisted strip.
+    {
+      GProp_GProps area, length;
+      BRepGProp::SurfaceProperties(model.faces(f + 1), area);
+      BRepGProp::LinearProperties(model.faces(f + 1), length);
+      if (area.Mass() > 0 && length.Mass() > 0) s = std::min(s, kNarrowFaceFactor * 2 * area.Mass() / length.Mass());
+    }
     if (points_per_circle_ > 0) {
       const double k = analytic_face_curvature(TopoDS::Face(model.faces(f + 1)));
       if (k > 0) s = std::min(s, kTwoPi / (k * points_per_circle_));

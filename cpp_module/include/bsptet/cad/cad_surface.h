@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bsptet/cad/cad_model.h"
@@ -43,6 +44,8 @@ struct CadSurfaceOptions {
 struct CadSurfaceStats {
   std::int64_t nodes = 0, triangles = 0;
   std::int64_t folds = 0;         ///< face triangles whose normal opposes the surface's
+  /// (CAD face index, folded triangles) of each face that kept folds, in face order: for messages
+  std::vector<std::pair<int, int>> folded_faces;
   double min_quality = 1;         ///< smallest triangle shape quality (face_mesher.h)
   double size = 0, min_size = 0;  ///< the size field's h and floor (automatic ones resolved)
   double seconds = 0;

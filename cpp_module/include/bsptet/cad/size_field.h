@@ -9,6 +9,8 @@
 //    offset...), the largest principal curvature at the point itself (local_curvature_size),
 //    so that one tight spot does not fine the whole face; on an edge, the curve's curvature at
 //    that parameter;
+//  * narrow faces: at most twice the face's mean width 2 * area / perimeter (a thread flank, a
+//    thin fillet or chamfer strip is crossed in one or two triangles, not by needles);
 //  * gradation: sizes grow away from smaller ones by at most `grading` per unit length (along an
 //    edge from its vertices, inside a face from its boundary nodes);
 // and never below `min_size` (CharacteristicLengthMin). Lengths in model units.
