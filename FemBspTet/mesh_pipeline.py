@@ -281,8 +281,7 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
     mesh.source = source or mesh.source
     faces = fem.boundary.triangles
     tags = fem.boundary.face_tags
-    midnodes = boundary_midnodes(mesh, faces) if mesh.order == 2 else \
-        np.zeros((0, 3), dtype=np.int64)
+    midnodes = fem.boundary_midnodes
 
     report("quality figures", 0.9)
     stats = dict(fem.stats)

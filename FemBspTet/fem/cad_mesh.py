@@ -26,19 +26,25 @@ class CadMeshResult:
     mesh: TetMesh
     tet_solid: np.ndarray
     boundary: Surface
+    #: (k, 3) tet10 mid-nodes of the boundary triangles' edges (a,b), (b,c), (c,a); (0, 3) for tet4
+    boundary_midnodes: np.ndarray
     stats: dict
+
+
+def _row_keys(triples):
+    """One hashable value per row of sorted corner triples (a void view), for np.unique / isin."""
+    rows = np.ascontiguousarray(np.sort(triples, axis=1).astype(np.int64))
+    return rows.view(np.dtype((np.void, rows.dtype.itemsize * 3))).ravel()
 
 
 def _boundary_rows(tets, triangles):
     """Rows of ``triangles`` (corner columns) that are faces of exactly one tet: the mesh's
     boundary (faces shared by two solids are inside it)."""
-    corners = np.sort(tets[:, :4], axis=1)
+    corners = tets[:, :4]
     faces = np.concatenate([corners[:, [0, 1, 2]], corners[:, [0, 1, 3]], corners[:, [0, 2, 3]],
                             corners[:, [1, 2, 3]]])
-    uniq, counts = np.unique(faces, axis=0, return_counts=True)
-    once = {tuple(f) for f in uniq[counts == 1].tolist()}
-    keys = np.sort(triangles[:, :3], axis=1).tolist()
-    return np.array([tuple(k) in once for k in keys], dtype=bool)
+    keys, counts = np.unique(_row_keys(faces), return_counts=True)
+    return np.isin(_row_keys(triangles[:, :3]), keys[counts == 1])
 
 
 def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face):
@@ -84,7 +90,9 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
                  input_points=int(stats["surface_nodes"]),
                  input_triangles=int(stats["surface_triangles"]),
                  boundary_steiner_points=0, steiner_points=int(stats["core_steiner_points"]))
-    return CadMeshResult(mesh=mesh, tet_solid=np.asarray(tet_solid), boundary=boundary, stats=stats)
+    midnodes = tri[on_boundary, 3:6] if tri.shape[1] == 6 else np.zeros((0, 3), dtype=np.int64)
+    return CadMeshResult(mesh=mesh, tet_solid=np.asarray(tet_solid), boundary=boundary,
+                         boundary_midnodes=midnodes, stats=stats)
 
 
 def mesh_cad_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
