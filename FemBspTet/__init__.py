@@ -12,7 +12,7 @@ from .errors import BspTetError, InputError, InternalError, NotImplementedYetErr
 from .mesh_types import Surface, TetMesh  # noqa: F401
 
 
-# --- FreeCAD scripting API (issue 5); each imports FreeCAD only when called -------------------
+# --- FreeCAD scripting API; each imports FreeCAD only when called -------------------
 
 def make_mesher(doc, part=None, name="MeshBspTet", **properties):
     """Create a BspTet mesher object (not meshed yet); see mesher_object.make_mesher."""

@@ -485,7 +485,7 @@ def signed_volume(surface: Surface) -> float:
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
-# ---- Quality stage (issue 4) -----------------------------------------------------------------
+# ---- Quality stage -----------------------------------------------------------------
 
 #: Options of the quality stage (cpp_module/include/bsptet/quality_refine.h), with their meaning.
 REFINE_OPTIONS = {

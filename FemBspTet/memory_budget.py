@@ -5,12 +5,12 @@
     require_within_budget(surfaces, budget)           # MemoryBudgetError if the estimate exceeds it
 
 The estimate is the typical peak with margin: about 1 to 3 KiB per input triangle measured from
-10^3 to 10^6 triangles (session 20, ``docs/bad-input.md``), taken as 4 KiB, plus the
+10^3 to 10^6 triangles (``docs/bad-input.md``), taken as 4 KiB, plus the
 interpreter's share. The BSP's size depends on the geometry, not only on the counts (inputs
 whose triangles cross many seed tets reach tens of KiB per triangle), so it is only a first
 filter: the supervised CLI also watches the run's real resident memory against the same budget
 (:mod:`FemBspTet.supervisor`) and stops it if it goes over. An envelope over those worst cases
-(session 2's 80 KiB per triangle) refused every input above a few 10^5 triangles on a 24 GiB
+(80 KiB per triangle) would refuse every input above a few 10^5 triangles on a 24 GiB
 machine, although 10^6 triangles take about 1 GiB.
 """
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Benchmark (not a test): the out-of-core mode (issue 8) beside the in-memory core and
+"""Benchmark (not a test): the out-of-core mode beside the in-memory core and
 `tetgen -pY` on the same surfaces: wall time and peak memory of each run, in the same process tree.
 
     bench/out_of_core.py [--families sphere,torus,cad] [--sizes 1e5,1e6] [--budgets 400M,200M]

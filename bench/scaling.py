@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Benchmark (not a test): how our core's time and peak memory grow with the input size, beside
-`tetgen -pY` and `tetgen -pq1.414` on the same surfaces (issue 8).
+`tetgen -pY` and `tetgen -pq1.414` on the same surfaces.
 
     bench/scaling.py [--families sphere,torus,cad] [--sizes 1e3,3e3,1e4,3e4,1e5]
                      [--max-triangles N] [--timeout S] [--ours worker|binary]

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fuzzes the readers and the core, time-boxed (issue 7). One target at a time, one process each.
+# Fuzzes the readers and the core, time-boxed. One target at a time, one process each.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET ...]
 #

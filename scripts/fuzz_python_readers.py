@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Time-boxed random-mutation fuzzing of the Python readers (issue 7).
+"""Time-boxed random-mutation fuzzing of the Python readers.
 
     scripts/fuzz_python_readers.py [--seconds 60] [--seed 1] [--findings DIR]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The C++ suite under AddressSanitizer + UndefinedBehaviorSanitizer (issue 7), in its own build
+# The C++ suite under AddressSanitizer + UndefinedBehaviorSanitizer, in its own build
 # directory (build-sanitize/; the Python extension is not built there, so the one in the source
 # tree stays uninstrumented). Runs the whole C++ suite: the unit tests (label `unit`: GoogleTest,
 # the fuzz-finding replays) and every corpus model (label `corpus`); any sanitizer report fails

@@ -1,4 +1,4 @@
-"""Bad input and faults (issue 7), through the command line as a user runs it.
+"""Bad input and faults, through the command line as a user runs it.
 
 The table below holds one bad input per row: how to make it, the exit code, the words of the
 message that name the problem and the place. Every row also checks that no output file (and no
@@ -490,7 +490,7 @@ def test_internal_error_of_the_core_is_reported_cleanly(cli, tmp_path):
 
 
 def test_meshing_error_of_the_core_becomes_exit_1_and_no_file(tmp_path, monkeypatch, capsys):
-    """The core's MeshingError (an internal limit; issue 3's business) through core.py and the CLI
+    """The core's MeshingError (an internal limit) through core.py and the CLI
     (in this process, without the supervisor): exit 1, a message saying it is a bug, no file."""
     from FemBspTet import _bsptet, cli
 

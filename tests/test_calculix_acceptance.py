@@ -1,4 +1,4 @@
-"""CalculiX acceptance of the FreeCAD mesher (issue 5), headless: the same analysis solved with our
+"""CalculiX acceptance of the FreeCAD mesher, headless: the same analysis solved with our
 mesh and with FreeCAD's Gmsh mesh at the same CharacteristicLengthMax.
 
 The acceptance figures of the FreeCAD issue: the cantilever's maximum displacement within 1% of

@@ -3,7 +3,7 @@
 ``tetrahedralize`` (cpp_module/src/mesher.cpp) retries when its Steiner removal cannot move a
 surface Steiner point inside: first with the other refinement of the covered faces (along whole
 input edge lines), then with other BSP partitions (``BspComplex::set_candidate_shift`` 1, 2).
-Since session 13 the first attempt starts the BSP from the Delaunay tetrahedralization of the
+The first attempt starts the BSP from the Delaunay tetrahedralization of the
 input points (``bsp_seed`` "auto"); a seeded attempt that fails is retried from the box, the
 paper's partition, with the retries above. ``stats["retries"]`` counts the failed attempts, ``stats["bsp_candidate_shift"]`` names the
 partition that made the mesh.
@@ -17,8 +17,8 @@ partition that made the mesh.
   which differ by 7e-15 in x and 2e-15 in z (nearly on one line), three Steiner points on that
   line, and a BSP point 1.4e-14 from input point 1314: a plane passing within rounding of an input
   vertex leaves a fan of slivers that no candidate point sees strictly. Candidate shift 1 fails
-  too, shift 2 meshes it (session 7); since session 8's core changes (BSP cell ids, RELOCATE's
-  candidate directions) shift 1 meshes it.
+  too with an older core; since the core's BSP cell ids and RELOCATE's candidate directions,
+  shift 1 meshes it.
 """
 
 import os
@@ -44,8 +44,8 @@ def test_bottle_at_deflection_diag200_meshes_after_retries():
     s = _bottle()
     mesh, stats = core.tetrahedralize(s, {"bsp_seed": "box"})
     _valid_without_surface_steiner(s, mesh)
-    # The path it takes today (session 8): the first attempt and the one along lines fail, shift 1
-    # makes the mesh (session 7: shift 2). If an earlier attempt starts to succeed, update these
+    # The path it takes today: the first attempt and the one along lines fail, shift 1 makes the
+    # mesh. If an earlier attempt starts to succeed, update these
     # figures (and docs/core-design.md).
     assert stats["bsp_seed"] == "box"
     assert stats["retries"] == 2
@@ -54,7 +54,7 @@ def test_bottle_at_deflection_diag200_meshes_after_retries():
 
 
 def test_bottle_at_deflection_diag200_meshes_at_once_from_the_delaunay_seed():
-    """The default start (the Delaunay seed, session 13) meshes it at the first attempt: the seed's
+    """The default start (the Delaunay seed) meshes it at the first attempt: the seed's
     cells are split only by the triangles that cross them, and no plane passes within rounding of
     the needle's corners there."""
     s = _bottle()

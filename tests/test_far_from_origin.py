@@ -1,4 +1,4 @@
-"""Coordinates at any sane scale (issue 7): models translated far from the origin, alone and with
+"""Coordinates at any sane scale: models translated far from the origin, alone and with
 rotations and scales, mesh as well as the original. Scales 1e-6..1e6 with moderate translations
 are in test_mesher_properties.py; here the translation dominates the coordinates (up to 1e8 times
 the model size, leaving about 26 bits of the doubles for the shape). Each mesh is checked exactly

@@ -235,7 +235,7 @@ def test_auto_seed_takes_the_box_when_triangles_cross_many_seed_tets():
     """A prism twisted by a quarter turn: its long side triangles cross many tets of the Delaunay
     seed, and flips recover only half of its missing side edges. "auto" stops its walks as soon
     as the crossings pass 4 per input triangle and meshes from the box; forcing the seed still
-    gives a valid mesh. (``joint`` did this until the seed's edge removals, session 23.)"""
+    gives a valid mesh. (``joint`` did this before the seed's edge removals.)"""
     s = skewed_ring_prism(64, 16, 2.0)
     bound = int(4 * len(s.triangles))
     mesh, stats = core.tetrahedralize(s)

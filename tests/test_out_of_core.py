@@ -1,4 +1,4 @@
-"""The out-of-core mode (issue 8): a solid meshed in pieces small enough for a memory budget,
+"""The out-of-core mode: a solid meshed in pieces small enough for a memory budget,
 from Python and from the command line. Every mesh is read back and checked exactly against the
 input surface (the checker knows nothing of the pieces)."""
 

@@ -1,4 +1,4 @@
-"""The quality stage (issue 4): size control, optimization, tet10, the projection hook.
+"""The quality stage: size control, optimization, tet10, the projection hook.
 
 Every mesh is checked exactly here again (core.check_mesh), independently of the check inside
 core.refine; the assertions are invariants on real data: validity, input points kept, edge lengths
@@ -115,7 +115,7 @@ def test_rounded_surface_points_stay_within_rounding_of_the_input():
         d = np.abs(np.einsum("ij,ij->i", q - p[tri[:, 0]], n))
         assert d.min() < 1e-14 * diag(surface)
     # Edges left longer than 2 h are those the last size round could not split without making a
-    # tet worse than those it replaces (counted); session 13's core gives this polyhedron an
+    # tet worse than those it replaces (counted); the core gives this polyhedron an
     # interior edge of 2.6 h there.
     lengths = edge_lengths(mesh)
     assert (lengths > 2.0 * h * (1 + 1e-9)).sum() <= stats["refine"]["long_edges_left"] <= 2
@@ -141,7 +141,7 @@ def test_optimization_rounds_do_not_grow_the_mesh_without_raising_its_angles(nam
     angles make every split there another sliver, eight rounds grew the mesh round after round
     (pinion at h = diagonal / 20: 2,170 tets after one round, 14,293 after eight; adis16480
     21,000 -> 157,000 in 143 s) while the worst angle stayed where one round left it. With the
-    rule, eight rounds stay within 2.5 times one round's tets (pinion, session 19, with the flat
+    rule, eight rounds stay within 2.5 times one round's tets (pinion, with the flat
     collapse pass: 2,277 -> 4,762 tets, worst angle 3.51 -> 4.37; without that pass 2,261 ->
     4,066, 2.84 -> 4.24)."""
     surface = read_surface(corpus_path(name))
@@ -254,12 +254,10 @@ def test_cantilever_box_end_faces_are_exact():
     near_end = nodes[np.isclose(pts[nodes, 0], 0.0, atol=1e-6) | np.isclose(pts[nodes, 0], 8000.0,
                                                                              atol=1e-6)]
     assert set(np.unique(pts[near_end, 0]).tolist()) == {0.0, 8000.0}
-    # Issue 4 asks for +-30% of Gmsh's 400. The quality stage's count depends on the order in
-    # which it visits the core's tets: session 16 (caps replaced by insertion, sliver splits that
-    # never lower the worst angle) gives 501 on the default path and 480 to 527 (mean 506; worst
-    # angle 13.3 degrees on all) over 16 random orders of the box-started core's tets (session
-    # 15: 519, and 452 to 511). So the 30% (520) is met on the default path but not on every
-    # order; the bound here is 35% until the count is robust (README, "What does not work yet").
+    # The target is +-30% of Gmsh's 400. The quality stage's count depends on the order in
+    # which it visits the core's tets: 501 on the default path and 480 to 527 (mean 506; worst
+    # angle 13.3 degrees on all) over 16 random orders of the box-started core's tets. So the
+    # 30% (520) is met on the default path but not on every order; the bound here is 35% until the count is robust (README, "What does not work yet").
     # Gmsh itself (python3-gmsh 4.11, the OCC box) makes 362 tets at 500.
     assert 0.7 * 400 <= stats["tets"] <= 1.35 * 400
     lengths = edge_lengths(mesh)

@@ -1,4 +1,4 @@
-"""The generators and the exponent fit of bench/scaling.py (issue 8's scaling benchmark).
+"""The generators and the exponent fit of bench/scaling.py (the scaling benchmark).
 
 Small sizes only; no mesher runs here (speed and memory are measured by the benchmark itself).
 """

@@ -1,4 +1,4 @@
-"""CalculiX acceptance cases of the FreeCAD mesher (issue 5), headless: the same analysis solved
+"""CalculiX acceptance cases of the FreeCAD mesher, headless: the same analysis solved
 with our mesh and with FreeCAD's Gmsh mesh at the same size.
 
 * ``cantilever``: steel box 8000 x 1000 x 1000 mm, Face1 (x = 0) fixed, 9e6 N in -z on Face2

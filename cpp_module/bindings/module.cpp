@@ -333,7 +333,7 @@ PYBIND11_MODULE(_bsptet, m) {
       "does, its self-intersection search beside the core (mesher.h check_and_tetrahedralize; the mesh "
       "is made from the checked triangles, re-oriented when reorient is set).");
 
-  // The out-of-core mode (out_of_core.h), issue 8.
+  // The out-of-core mode (out_of_core.h).
   m.def(
       "tetrahedralize_in_pieces",
       [](const DoubleArray& points, const IndexArray& triangles, const std::string& stem,
@@ -375,7 +375,7 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def("piece_triangles_for_budget", &piece_triangles_for_budget, py::arg("budget_bytes"),
         "The largest piece (triangles) the out-of-core mode's estimate fits in budget_bytes (out_of_core.h).");
 
-  // The input surface check (surface_check.h), issue 7. A self-intersection raises InputError
+  // The input surface check (surface_check.h). A self-intersection raises InputError
   // with `pairs` (k, 2) and `complete` besides `code` and `index`.
   m.def(
       "check_surface",
@@ -405,7 +405,7 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("max_reported_pairs") = 1000,
       "Checks a triangle surface before meshing (see surface_check.h). Returns (triangles (m, 3) with "
       "flipped ones reversed, info dict). Raises InputError naming the first problem.");
-  // ---- Quality stage (issue 4): refine_quality (quality_refine.h). ----
+  // ---- Quality stage: refine_quality (quality_refine.h). ----
   m.def(
       "refine",
       [](const DoubleArray& surface_points, const IndexArray& surface_triangles, py::object surface_tags,

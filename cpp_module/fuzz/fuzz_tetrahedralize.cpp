@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::fprintf(stderr, "the core refused a surface the input check accepted: %s\n", e.what());
     fuzz_require(false);
   } catch (const MeshingError&) {
-    return 0;  // an internal limit of the core (issue 3), typed and reported; not a crash
+    return 0;  // an internal limit of the core, typed and reported; not a crash
   }
   const MeshCheckReport r = check_mesh(s, m);
   if (!r.valid)

@@ -1,5 +1,5 @@
 // FemBspTet core: seeding the BSP complex with a Delaunay tetrahedralization of the input points
-// (issue 8; the idea of Diazzi & Attene's BSP complex, 2021), see bsp_complex.h.
+// (the idea of Diazzi & Attene's BSP complex, 2021), see bsp_complex.h.
 //
 // Instead of one box cell cut by every input plane, the complex starts as the tets of the exact
 // (perturbed) Delaunay tetrahedralization of the input points and the 8 box corners. Each tet is a
@@ -255,7 +255,7 @@ int tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 
 //    face) or ab passes through a seed edge that planar_flip cannot replace, that edge is removed
 //    by EDGE REMOVAL over any triangulation of its ring, or where none is valid, after the
 //    removal of one of its spokes (remove_edge_deep: Si's flipnm, as in TetGen, one level deep).
-//    Session 23: recovered edges 863 -> 1090 of 1102 on triceratops, 124 -> 246 of 264 on
+//    Measured: edge removal raises the recovered edges 863 -> 1090 of 1102 on triceratops, 124 -> 246 of 264 on
 //    couplingdown, 54 -> 144 of 180 on joint (whose seed the auto choice had dropped for the
 //    box); core time 0.4 to 0.6 of what it was on these.
 class SeedFlips {

@@ -19,7 +19,7 @@ constexpr auto& kFace = kTetOppositeFace;
 class Builder {
  public:
   Builder(ImplicitGeometry& geo, const std::vector<Index>& order) : geo_(geo), ids_(order) {
-    std::uint64_t s = 0x5eedULL;  // the walk's face order (the seed's before session 20)
+    std::uint64_t s = 0x5eedULL;  // the walk's face order
     rng_ = splitmix64(s);
     pts_.reserve(order.size());
     for (Index v : order) pts_.push_back(geo.explicit_point(geo.explicit_id(v)));

@@ -43,7 +43,7 @@ inline void kept_axes(int axis, int& u, int& v) {
   v = (axis + 2) % 3;
 }
 
-// Exactness certificates (issue 7: coplanar and collinear inputs, whose determinants are exactly
+// Exactness certificates (coplanar and collinear inputs, whose determinants are exactly
 // zero, defeat every filter; on CAD tessellations most of them are on a coarse grid where every
 // operation of the double evaluation is exact). Each helper computes one operation in doubles and
 // says whether the result is exact: a difference by Knuth's TwoSum error term (exact with

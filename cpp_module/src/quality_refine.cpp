@@ -1110,9 +1110,9 @@ class Refiner {
   }
 
   // Curved tet10 through a projection hook (FreeCAD's tet10). Its insertion and sliver passes
-  // stay as they were before session 16 (no forced tet, one height, the h / 8 clearance floor,
+  // stay in their earlier form (no forced tet, one height, the h / 8 clearance floor,
   // sliver splits not held to the worst angle; only insert_point's walk is the new one): the
-  // curving stage after them needs the room those left over curved faces. With session 16's
+  // curving stage after them needs the room those left over curved faces. With the newer
   // passes 9 of the 13 CAD corpus files meshed at tet10 instead of 10 (featuretype.STEP and
   // bottle.brep stopped with inverted curved elements, SampleCrankshaft4A meshed).
   bool curved_tet10() const { return o_.order == 2 && static_cast<bool>(o_.projection); }

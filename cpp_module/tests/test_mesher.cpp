@@ -31,7 +31,7 @@ struct PaperCase {
 class PaperPolyhedron : public ::testing::TestWithParam<PaperCase> {};
 
 // The default output must be fully valid (exact checker), with no Steiner point on the surface.
-// Steiner counts are printed beside the paper's and TetGen's, and must not exceed TetGen's (issue 3;
+// Steiner counts are printed beside the paper's and TetGen's, and must not exceed TetGen's
 // box_with_hole reaches TetGen's 0 through RETETRAHEDRALIZE, steiner_removal.h).
 TEST_P(PaperPolyhedron, DefaultMeshIsValidWithNoSurfaceSteinerPoint) {
   const PaperCase c = GetParam();

@@ -5,7 +5,7 @@
 // global vertex id): the same predicates decide it (orient3d on the doubles, the in-sphere sign of
 // ImplicitGeometry::lifted_det3 and, on a hull plane, lifted_det2), and under them it is unique,
 // so it equals delaunay_cell's on the same points as a set of tets. What differs is the cost
-// (the seed used cell_delaunay's builder until session 20): points as plain
+// (compared with cell_delaunay's builder): points as plain
 // doubles in a flat array, the floating-point filters called directly (ImplicitGeometry only for
 // the cases they cannot certify), the cavity's new tets linked by their edges without allocation,
 // and the neighbours of every tet returned beside it.
