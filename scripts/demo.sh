@@ -6,5 +6,5 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$ROOT/scripts/setup.sh"
 mkdir -p "$ROOT/out"
 "$ROOT/bin/fembsptet" mesh "$ROOT/resources/samples/bracket.step" \
-  -o "$ROOT/out/bracket.inp" -o "$ROOT/out/bracket.vtu" --stats-json "$ROOT/out/bracket.stats.json" \
+  --order 2 -o "$ROOT/out/bracket.inp" -o "$ROOT/out/bracket.vtu" --stats-json "$ROOT/out/bracket.stats.json" \
   --compare-tetgen
