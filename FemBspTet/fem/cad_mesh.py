@@ -47,6 +47,64 @@ def _boundary_rows(tets, triangles):
     return np.isin(_row_keys(triangles[:, :3]), keys[counts == 1])
 
 
+def _check_each_solid(points, corner_tets, tet_solid, cad_triangles, source):
+    """The exact check of every solid's corner tets against the faces of exactly one of its tets,
+    and those faces equal to CAD triangles (``cad_triangles``, merged ids), every CAD triangle a
+    face of a tet; InternalError naming the solid if one fails."""
+    from ..core import boundary_surface, check_mesh
+    from ..errors import InternalError
+
+    cad_keys = _row_keys(cad_triangles)
+    tet_faces = np.concatenate([corner_tets[:, [0, 1, 2]], corner_tets[:, [0, 1, 3]],
+                                corner_tets[:, [0, 2, 3]], corner_tets[:, [1, 2, 3]]])
+    unused = ~np.isin(cad_keys, _row_keys(tet_faces))
+    if unused.any():
+        raise InternalError(f"{source}: {int(unused.sum())} CAD surface triangles are faces of no "
+                            "tet of the FEM mesh; this is a bug, please report it")
+    for solid in np.unique(tet_solid):
+        tets = corner_tets[tet_solid == solid]
+        used, local = np.unique(tets, return_inverse=True)
+        pts = points[used]
+        piece = TetMesh(points=pts, tets=local.reshape(tets.shape).astype(np.int64), source=source)
+        boundary = boundary_surface(piece)
+        off_cad = ~np.isin(_row_keys(used[boundary.triangles]), cad_keys)
+        if off_cad.any():
+            raise InternalError(f"{source}: Solid{solid}: {int(off_cad.sum())} boundary faces of the "
+                                "FEM mesh are not triangles of the CAD surface; this is a bug, "
+                                "please report it")
+        report = check_mesh(boundary, piece,
+                            max_messages=5, compute_quality=False)
+        if not report["valid"]:
+            raise InternalError(f"{source}: Solid{solid}: the FEM mesh failed its own exact check ("
+                                + "; ".join(report["messages"]) + "); this is a bug, please report it")
+
+
+def _touching_solids(points, corner_tets, tet_solid):
+    """Pairs [a, b] (a < b) of solids with distinct nodes at the same coordinates: they touch without
+    sharing a CAD face, so their meshes are not connected there."""
+    node_solid = np.full(len(points), -1, dtype=np.int64)
+    node_solid[corner_tets.ravel()] = np.repeat(tet_solid, 4)
+    used = np.flatnonzero(node_solid >= 0)
+    if len(used) == 0:
+        return []
+    _, group, counts = np.unique(points[used], axis=0, return_inverse=True, return_counts=True)
+    group = group.ravel()
+    shared = counts[group] > 1
+    if not shared.any():
+        return []
+    order = np.lexsort((node_solid[used][shared], group[shared]))
+    g = group[shared][order]
+    s = node_solid[used][shared][order]
+    pairs = set()
+    start = 0
+    for end in range(1, len(g) + 1):
+        if end == len(g) or g[end] != g[start]:
+            solids = sorted(set(s[start:end].tolist()))
+            pairs.update((a, b) for i, a in enumerate(solids) for b in solids[i + 1:])
+            start = end
+    return [list(p) for p in sorted(pairs)]
+
+
 def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face):
     if order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}", where=source)
@@ -72,20 +130,24 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
                        face_tags=np.asarray(tri_face, dtype=np.int32)[on_boundary],
                        face_names=None, source=source)
     stats = dict(stats)
-    # The corner mesh checked exactly against its own boundary (positive tets, conforming faces,
-    # a closed boundary equal to the CAD faces' unshared triangles); corners come first.
-    from ..core import check_mesh
-
+    # Each solid's corner mesh checked exactly against its own boundary (positive tets, conforming
+    # faces, a closed boundary equal to the solid's CAD triangles); corners come first. Solids are
+    # checked one by one because solids that touch without sharing a CAD face (an assembly that was
+    # not fragmented) have coincident but distinct nodes there, which a check of the whole would
+    # call non-conforming.
     corners = int(stats["corner_nodes"])
-    report = check_mesh(Surface(points=mesh.points[:corners], triangles=boundary.triangles,
-                                face_tags=boundary.face_tags, source=source),
-                        TetMesh(points=mesh.points[:corners], tets=mesh.tets[:, :4].copy()),
-                        max_messages=5, compute_quality=False)
-    if not report["valid"]:
-        from ..errors import InternalError
-
-        raise InternalError(f"{source}: the FEM mesh failed its own exact check ("
-                            + "; ".join(report["messages"]) + "); this is a bug, please report it")
+    tet_solid = np.asarray(tet_solid, dtype=np.int64)
+    _check_each_solid(mesh.points[:corners], mesh.tets[:, :4], tet_solid, tri[:, :3], source)
+    touching = _touching_solids(mesh.points[:corners], mesh.tets[:, :4], tet_solid)
+    if touching:
+        stats["unconnected_touching_solids"] = touching
+        pairs = ", ".join(f"Solid{a}-Solid{b}" for a, b in touching[:6])
+        more = f" and {len(touching) - 6} more" if len(touching) > 6 else ""
+        stats.setdefault("notes", []).append(
+            f"{len(touching)} pairs of solids touch without sharing a CAD face ({pairs}{more}): "
+            "their meshes have separate nodes there and are not connected; to make them "
+            "conforming, fuse them into one CompSolid first (FreeCAD: Part, Boolean Fragments "
+            "in CompSolid mode) or tie them in the solver")
     stats.update(valid=True, points=int(stats.get("nodes", len(points))),
                  input_points=int(stats["surface_nodes"]),
                  input_triangles=int(stats["surface_triangles"]),
