@@ -26,6 +26,21 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFlatCollapseBelowDeg = 1.0;
 // Edge removals (RefineMesh::remove_edge) look at shells of at most this many tets.
 constexpr int kMaxEdgeRing = 7;
+// Tets below this are polished once the curved elements have room (Refiner::polish_curved).
+constexpr double kPolishCurvedBelowDeg = 15.0;
+// ODT smoothing (Refiner::odt_smooth_pass) never takes a tet below this or below the worst before.
+constexpr double kOdtKeepDeg = 30.0;
+// Delaunay refinement (Refiner::delaunay_refine_phase): tets with a circumradius above this times
+// the target get a point; none lands closer than kRefineSpacing times the target to the points
+// of its cavity. A regular tet of edge h has circumradius 0.61 h.
+constexpr double kRefineCircumradius = 0.9;
+constexpr double kRefineSpacing = 0.8;
+// The flip and smoothing passes of the optimization rounds work on the tets below this (or below
+// min_dihedral_deg when it is higher): above it a flip or a move rarely pays for its search
+// (flips up to 70 degrees took 3 to 6 times the refinement's time for a median 0.2 degree
+// better; the ODT smoothing evens out the typical tet instead).
+constexpr double kFlipBelowDeg = 35.0;
+using MoveAccept = std::function<bool(const std::vector<std::array<Vec3, 4>>&)>;
 
 // Face (A, B, C) of a tet whose fourth corner is D, for placing points over it.
 struct FaceFrame {
@@ -85,6 +100,7 @@ class Refiner {
 
   void run() {
     timed("targets", [&] { compute_targets(); return 0; });
+    timed("size", [&] { delaunay_refine_phase(); return 0; });
     timed("size", [&] { size_phase(); return 0; });
     tets_after_size_ = m_.num_alive_tets();
     optimize_phase(o_.optimize_rounds);
@@ -105,6 +121,8 @@ class Refiner {
       }
     }
     timed("curving", [&] { lift_for_curved_elements(); return 0; });
+    if (o_.projection && o_.order == 2)
+      timed("curving", [&] { return polish_curved(kPolishCurvedBelowDeg); });
     // Counted last (the smoothing after separate_face_tags and the lifts move points too) against
     // the asked sizes: the targets raised around edges that could not be split do not count.
     compute_targets(false);
@@ -332,6 +350,58 @@ class Refiner {
     budget_ = m_.num_points() + static_cast<Index>(std::min(estimate + 1000.0, 5e8));
   }
 
+  // ---- Phase 1a: interior points by Delaunay refinement ---------------------------------------
+  // Tets whose circumradius exceeds kRefineCircumradius * their target (the mean of their
+  // corners') get a point at their circumcentre, inserted Bowyer-Watson (RefineMesh::insert_point:
+  // the cavity is shaped by the circumspheres, made star-shaped exactly), largest relative radius
+  // first, in rounds until none is left. The spacing rule: the insertion is refused when a vertex
+  // of its cavity is closer than kRefineSpacing * the target there, so every new point keeps that
+  // distance from the points it connects to and the refinement ends. A circumcentre outside the
+  // solid (or on its boundary) is skipped: the surface is already at size (the CAD surface
+  // mesher), and the edge-split phase after this one splits what is still long. Points spread
+  // this way are far more regular than midpoints of split edges, so the optimization that
+  // follows has less to mend. Only with a finite size.
+  void delaunay_refine_phase() {
+    if (!std::isfinite(o_.size)) return;
+    set_budget();
+    std::vector<std::uint64_t> refused_at;  // failure memory as the flip pass's
+    for (int round = 0; round < o_.max_passes; ++round) {
+      poll("refining to size", std::min(0.4, 0.04 * round));
+      std::vector<std::tuple<double, Index>> todo;
+      for (Index t = 0; t < m_.num_tet_slots(); ++t) {
+        if (!m_.tet_alive(t) || failed_before(refused_at, t)) continue;
+        const auto& q = m_.tet(t);
+        Vec3 c;
+        double r2 = 0;
+        if (!tet_circumsphere(m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3]), &c, &r2)) continue;
+        const double tg = 0.25 * (target(q[0]) + target(q[1]) + target(q[2]) + target(q[3]));
+        const double ratio = std::sqrt(r2) / tg;
+        if (ratio > kRefineCircumradius) todo.emplace_back(-ratio, t);
+      }
+      if (todo.empty()) break;
+      std::sort(todo.begin(), todo.end());
+      std::int64_t done = 0;
+      for (const auto& [key, t] : todo) {
+        if (m_.num_points() >= budget_) return;
+        if (!m_.tet_alive(t)) continue;
+        const auto q = m_.tet(t);
+        Vec3 c;
+        double r2 = 0;
+        if (!tet_circumsphere(m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3]), &c, &r2)) continue;
+        const double tg = 0.25 * (target(q[0]) + target(q[1]) + target(q[2]) + target(q[3]));
+        Index p = -1;
+        if (m_.insert_point(t, c, kRefineSpacing * tg, &p, 256) == InsertOutcome::kInserted) {
+          ++st_.refinement_points;
+          set_target(p, tg);
+          ++done;
+        } else {
+          record_failure(refused_at, t);
+        }
+      }
+      if (done == 0) break;
+    }
+  }
+
   // `min_quality`: as RefineMesh::split_edge's (0: any valid split).
   void size_phase(double min_quality = 0) {
     set_budget();
@@ -465,44 +535,10 @@ class Refiner {
   // curving_conflicts_left.
   void lift_for_curved_elements() {
     if (!o_.projection || o_.order != 2) return;
-    static const int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
     constexpr auto& kFace = kTetOppositeFace;  // types.h
-    std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> tags;
-    for (const auto& [face, parent] : m_.boundary_faces())
-      for (int k = 0; k < 3; ++k) {
-        const Index a = face[k], b = face[(k + 1) % 3];
-        const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
-        const std::int32_t tag = m_.tag_of(parent);
-        auto it = tags.find(key);
-        if (it == tags.end())
-          tags.emplace(key, std::array<std::int32_t, 2>{tag, tag});
-        else
-          it->second[1] = tag;
-      }
-    std::map<std::array<Index, 2>, Vec3> projected;  // boundary points never move: a safe cache
+    prepare_curved_check();
     auto curved_ok = [&](const std::array<Index, 4>& q, const std::array<Vec3, 4>& P) {
-      double x[30];
-      bool curved = false;
-      for (int k = 0; k < 4; ++k) x[3 * k] = P[k].x, x[3 * k + 1] = P[k].y, x[3 * k + 2] = P[k].z;
-      for (int e = 0; e < 6; ++e) {
-        const int i = kEdge[e][0], j = kEdge[e][1];
-        Vec3 mid{0.5 * (P[i].x + P[j].x), 0.5 * (P[i].y + P[j].y), 0.5 * (P[i].z + P[j].z)};
-        const std::array<Index, 2> key{std::min(q[i], q[j]), std::max(q[i], q[j])};
-        auto tg = tags.find(key);
-        if (tg != tags.end()) {
-          auto pr = projected.find(key);
-          if (pr == projected.end()) {
-            const auto tt = tg->second;
-            Vec3 y = o_.projection(mid, tt[0], tt[1] != tt[0] ? tt[1] : -1);
-            if (!std::isfinite(y.x) || !std::isfinite(y.y) || !std::isfinite(y.z)) y = mid;
-            pr = projected.emplace(key, y).first;
-          }
-          curved = curved || squared_distance(pr->second, mid) > 0;
-          mid = pr->second;
-        }
-        x[3 * (4 + e)] = mid.x, x[3 * (4 + e) + 1] = mid.y, x[3 * (4 + e) + 2] = mid.z;
-      }
-      return !curved || certify_tet10(x) == Tet10Validity::kCertified;
+      return curved_element_ok(q, P);
     };
     auto corners = [&](const std::array<Index, 4>& q) {
       return std::array<Vec3, 4>{m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3])};
@@ -606,6 +642,181 @@ class Refiner {
       }
       if (lifted == 0) return;
     }
+  }
+
+  // ---- Curved tet10 validity -------------------------------------------------------------------
+  // Once the surface is final: the tags of each boundary edge's faces, for the projection hook.
+  void prepare_curved_check() {
+    edge_tags_.clear();
+    projected_.clear();
+    for (const auto& [face, parent] : m_.boundary_faces())
+      for (int k = 0; k < 3; ++k) {
+        const Index a = face[k], b = face[(k + 1) % 3];
+        const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+        const std::int32_t tag = m_.tag_of(parent);
+        auto it = edge_tags_.find(key);
+        if (it == edge_tags_.end())
+          edge_tags_.emplace(key, std::array<std::int32_t, 2>{tag, tag});
+        else
+          it->second[1] = tag;
+      }
+  }
+
+  // True when the tet10 of corners q at positions P, its boundary edges' mid-nodes on the true
+  // surface (projection hook) and the others straight, has a Jacobian determinant certified
+  // positive (certify_tet10); straight elements are true at once (their corner tet is positive).
+  bool curved_element_ok(const std::array<Index, 4>& q, const std::array<Vec3, 4>& P) {
+    static const int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+    double x[30];
+    bool curved = false;
+    for (int k = 0; k < 4; ++k) x[3 * k] = P[k].x, x[3 * k + 1] = P[k].y, x[3 * k + 2] = P[k].z;
+    for (int e = 0; e < 6; ++e) {
+      const int i = kEdge[e][0], j = kEdge[e][1];
+      Vec3 mid{0.5 * (P[i].x + P[j].x), 0.5 * (P[i].y + P[j].y), 0.5 * (P[i].z + P[j].z)};
+      const std::array<Index, 2> key{std::min(q[i], q[j]), std::max(q[i], q[j])};
+      auto tg = edge_tags_.find(key);
+      if (tg != edge_tags_.end()) {
+        auto pr = projected_.find(key);  // boundary points never move: a safe cache
+        if (pr == projected_.end()) {
+          const auto tt = tg->second;
+          Vec3 y = o_.projection(mid, tt[0], tt[1] != tt[0] ? tt[1] : -1);
+          if (!std::isfinite(y.x) || !std::isfinite(y.y) || !std::isfinite(y.z)) y = mid;
+          pr = projected_.emplace(key, y).first;
+        }
+        curved = curved || squared_distance(pr->second, mid) > 0;
+        mid = pr->second;
+      }
+      x[3 * (4 + e)] = mid.x, x[3 * (4 + e) + 1] = mid.y, x[3 * (4 + e) + 2] = mid.z;
+    }
+    return !curved || certify_tet10(x) == Tet10Validity::kCertified;
+  }
+
+  std::array<Vec3, 4> corner_points(const std::array<Index, 4>& q) const {
+    return {m_.point(q[0]), m_.point(q[1]), m_.point(q[2]), m_.point(q[3])};
+  }
+
+  // After the lifts (curved tet10 through a hook): the tets below `below` degrees, worst first,
+  // get 3-2 and 2-3 flips, edge removals, moves of their interior corners (towards their
+  // neighbours' centroid, then steepest ascent) and collapses of their interior Steiner corners.
+  // A change is applied when the worst tet it makes is better than the worst it replaces and the
+  // curved elements it makes invalid are not more than those it removes (the lifts and insertions
+  // for curved elements accept down to 1 degree; this takes the worst back up). Input points and
+  // the surface never move. Rounds until nothing changes (at most 4); returns the changes made.
+  std::int64_t polish_curved(double below) {
+    const TetsAccept accept = [&](const std::vector<std::array<Index, 4>>& removed,
+                                  const std::vector<std::array<Index, 4>>& created) {
+      double worst_before = 180;
+      int bad_before = 0;
+      for (const auto& r : removed) {
+        const auto P = corner_points(r);
+        worst_before = std::min(worst_before, tet_min_dihedral_deg(P[0], P[1], P[2], P[3]));
+        bad_before += !curved_element_ok(r, P);
+      }
+      std::vector<std::array<Vec3, 4>> made;
+      made.reserve(created.size());
+      for (const auto& c : created) {
+        made.push_back(corner_points(c));
+        const auto& P = made.back();
+        if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) <= worst_before) return false;
+      }
+      int bad_after = 0;
+      for (std::size_t i = 0; i < created.size(); ++i)
+        if (!curved_element_ok(created[i], made[i]) && ++bad_after > bad_before) return false;
+      return true;
+    };
+    std::int64_t changes = 0;
+    for (int round = 0; round < 4; ++round) {
+      poll("optimizing curved elements", 0.97);
+      std::int64_t now = 0;
+      for (Index t : tets_below(below)) {
+        if (!m_.tet_alive(t) || m_.tet_quality(t) >= below) continue;
+        const auto q = m_.tet(t);
+        bool done = false;
+        for (int i = 0; i < 4 && !done; ++i)
+          for (int j = i + 1; j < 4 && !done; ++j)
+            if (m_.flip32(q[i], q[j], accept)) {
+              ++st_.flips32;
+              done = true;
+            }
+        for (int k = 0; k < 4 && !done; ++k)
+          if (m_.flip23(t, k, accept)) {
+            ++st_.flips23;
+            done = true;
+          }
+        for (int i = 0; i < 4 && !done; ++i)
+          for (int j = i + 1; j < 4 && !done; ++j)
+            if (m_.remove_edge(q[i], q[j], kMaxEdgeRing, accept, 4)) {
+              ++st_.edge_removals;
+              done = true;
+            }
+        for (int k = 0; k < 4 && !done; ++k)
+          if (move_keeping_curved(q[k])) {
+            ++st_.relocations;
+            done = true;
+          }
+        for (int k = 0; k < 4 && !done; ++k) {
+          const Index from = q[k];
+          if (m_.support(from).kind != Support::kInterior) continue;
+          std::vector<std::pair<double, Index>> near;
+          for (Index s2 : m_.tets_around_point(from))
+            for (Index w : m_.tet(s2))
+              if (w != from) near.emplace_back(length(from, w), w);
+          std::sort(near.begin(), near.end());
+          near.erase(std::unique(near.begin(), near.end()), near.end());
+          for (const auto& [l, to] : near) {
+            const double lim = o_.split_ratio * target(to);
+            if (m_.collapse_edge(from, to, 0.0, std::isfinite(lim) ? lim * lim : kInf, accept)) {
+              ++st_.collapses;
+              done = true;
+              break;
+            }
+          }
+        }
+        now += done;
+      }
+      changes += now;
+      if (now == 0) break;
+    }
+    return changes;
+  }
+
+  // Moves interior point v where the worst tet around it gets better and no curved element
+  // around it becomes invalid that was valid: towards its neighbours' centroid (all, half, a
+  // quarter, a tenth of the way), then steepest ascent (ascend_point). True when v moved.
+  bool move_keeping_curved(Index v) {
+    if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
+    const std::vector<Index> ball = m_.tets_around_point(v);
+    double worst_before = 180;
+    int bad_before = 0;
+    Vec3 c{0, 0, 0};
+    int k = 0;
+    double mean_edge = 0;
+    for (Index t : ball) {
+      worst_before = std::min(worst_before, m_.tet_quality(t));
+      bad_before += !curved_element_ok(m_.tet(t), corner_points(m_.tet(t)));
+      for (Index w : m_.tet(t))
+        if (w != v) {
+          c.x += m_.point(w).x, c.y += m_.point(w).y, c.z += m_.point(w).z;
+          mean_edge += length(v, w);
+          ++k;
+        }
+    }
+    if (k == 0) return false;
+    c = {c.x / k, c.y / k, c.z / k};
+    mean_edge /= k;
+    const MoveAccept accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+      for (const auto& P : moved)
+        if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) <= worst_before) return false;
+      int bad_after = 0;
+      for (std::size_t i = 0; i < moved.size(); ++i)
+        if (!curved_element_ok(m_.tet(ball[i]), moved[i]) && ++bad_after > bad_before) return false;
+      return true;
+    };
+    const Vec3 p = m_.point(v);
+    for (double f : {1.0, 0.5, 0.25, 0.1})
+      if (m_.relocate_point_if(v, {p.x + f * (c.x - p.x), p.y + f * (c.y - p.y), p.z + f * (c.z - p.z)}, accept))
+        return true;
+    return ascend_point(v, mean_edge, &accept);
   }
 
   // Tries to make the invalid curved element t valid by changing the connectivity around it: 2-3
@@ -813,6 +1024,62 @@ class Refiner {
     return n;
   }
 
+  // ODT smoothing (optimal Delaunay triangulation, Chen and Holst; CGAL's odt_optimize_mesh_3):
+  // every interior point moves to the volume-weighted mean of its tets' circumcentres, the
+  // minimizer of the interpolation error of |x|^2 over its ball, which evens out the whole mesh
+  // rather than its worst tets only. A move is applied when every tet around stays positive
+  // (exact), the mean of their smallest dihedral angles rises, and their worst stays at least
+  // min(the worst before, kOdtKeepDeg). Points are visited in index order. Returns the moves.
+  std::int64_t odt_smooth_pass() {
+    std::int64_t n = 0;
+    for (Index v = 0; v < m_.num_points(); ++v) {
+      if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) continue;
+      const std::vector<Index> ball = m_.tets_around_point(v);
+      if (ball.empty()) continue;
+      double wsum = 0, mean_before = 0, worst_before = 180;
+      Vec3 x{0, 0, 0};
+      bool ok = true;
+      for (Index t : ball) {
+        const auto P = corner_points(m_.tet(t));
+        Vec3 c;
+        double r2 = 0;
+        if (!tet_circumsphere(P[0], P[1], P[2], P[3], &c, &r2)) {
+          ok = false;
+          break;
+        }
+        const double ux = P[1].x - P[0].x, uy = P[1].y - P[0].y, uz = P[1].z - P[0].z;
+        const double wx = P[2].x - P[0].x, wy = P[2].y - P[0].y, wz = P[2].z - P[0].z;
+        const double dx = P[3].x - P[0].x, dy = P[3].y - P[0].y, dz = P[3].z - P[0].z;
+        const double vol = std::abs(dx * (uy * wz - uz * wy) + dy * (uz * wx - ux * wz) + dz * (ux * wy - uy * wx));
+        x.x += vol * c.x, x.y += vol * c.y, x.z += vol * c.z;
+        wsum += vol;
+        mean_before += m_.tet_quality(t);
+        worst_before = std::min(worst_before, m_.tet_quality(t));
+      }
+      if (!ok || !(wsum > 0)) continue;
+      x = {x.x / wsum, x.y / wsum, x.z / wsum};
+      mean_before /= static_cast<double>(ball.size());
+      const double keep = std::min(worst_before, kOdtKeepDeg);
+      const MoveAccept accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+        double mean = 0;
+        for (const auto& P : moved) {
+          const double q = tet_min_dihedral_deg(P[0], P[1], P[2], P[3]);
+          if (q < keep) return false;
+          mean += q;
+        }
+        return mean / static_cast<double>(moved.size()) > mean_before + 1e-9;
+      };
+      const Vec3 p = m_.point(v);
+      for (double f : {1.0, 0.5})
+        if (m_.relocate_point_if(v, {p.x + f * (x.x - p.x), p.y + f * (x.y - p.y), p.z + f * (x.z - p.z)}, accept)) {
+          ++n;
+          break;
+        }
+    }
+    st_.relocations += n;
+    return n;
+  }
+
   // Moves interior points towards the centroid of their neighbours when it helps the worst tet.
   std::int64_t smooth_pass(double below) {
     std::vector<Index> pts;
@@ -890,7 +1157,7 @@ class Refiner {
   // the worst tets, a halving line search from 0.1 of the mean edge the step; a step is taken
   // only through relocate_point (exact positivity, a strictly better worst angle). At most 8
   // steps; true when v moved. The doubles here only choose candidates.
-  bool ascend_point(Index v, double mean_edge) {
+  bool ascend_point(Index v, double mean_edge, const MoveAccept* keep = nullptr) {
     if (!(mean_edge > 0)) return false;
     bool moved = false;
     for (int step = 0; step < 8; ++step) {
@@ -920,7 +1187,7 @@ class Refiner {
       bool ok = false;
       for (double a = 0.1 * mean_edge; a > 1e-3 * mean_edge && !ok; a *= 0.5) {
         const Vec3 q{p.x + a * g[0] / norm, p.y + a * g[1] / norm, p.z + a * g[2] / norm};
-        ok = worst_at(q) > f0 + 1e-9 && m_.relocate_point(v, q);
+        ok = worst_at(q) > f0 + 1e-9 && (keep ? m_.relocate_point_if(v, q, *keep) : m_.relocate_point(v, q));
       }
       if (!ok) break;
       moved = true;
@@ -1079,6 +1346,7 @@ class Refiner {
 
   void optimize_phase(int rounds) {
     const double goal = o_.min_dihedral_deg > 0 ? o_.min_dihedral_deg : 70.0;
+    const double goal_below = o_.min_dihedral_deg;  // 0 when not asked
     // The sliver pass runs while the number of tets below its bound falls from round to round. On
     // inputs whose small angles make every split near them another sliver it rose round after
     // round instead (adis16480 at h = diagonal / 20: 14,000 -> 62,000 such tets, 21,000 -> 157,000
@@ -1089,10 +1357,11 @@ class Refiner {
       std::int64_t changes = 0;
       changes += timed("collapse", [&] { return collapse_pass(); });
       changes += timed("collapse", [&] { return flat_collapse_pass(kFlatCollapseBelowDeg); });
-      changes += timed("flip", [&] { return flip_pass(std::max(goal, 30.0)); });
-      changes += timed("smooth", [&] { return smooth_pass(std::max(goal, 30.0)); });
+      changes += timed("smooth", [&] { return odt_smooth_pass(); });
+      changes += timed("flip", [&] { return flip_pass(std::max(goal_below, kFlipBelowDeg)); });
+      changes += timed("smooth", [&] { return smooth_pass(std::max(goal_below, kFlipBelowDeg)); });
       changes += timed("radius_edge", [&] { return radius_edge_pass(); });
-      changes += timed("flip", [&] { return flip_pass(std::max(goal, 30.0)); });
+      changes += timed("flip", [&] { return flip_pass(std::max(goal_below, kFlipBelowDeg)); });
       changes += timed("insert", [&] { return insert_pass(std::min(goal, 15.0)); });
       if (round + 1 < rounds && std::isfinite(o_.size)) {
         const std::size_t slivers = count_below(std::min(goal, 15.0));
@@ -1130,6 +1399,8 @@ class Refiner {
   const RefineOptions& o_;
   RefineStats& st_;
   std::vector<double> target_;
+  std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> edge_tags_;  // prepare_curved_check
+  std::map<std::array<Index, 2>, Vec3> projected_;  // hook results at boundary edge midpoints
   struct Stuck {  ///< an edge that could not be split
     Vec3 a, b;
     double lo[3], hi[3];

@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
     std::printf("  surface: nodes %lld triangles %lld\n", (long long)st.surface_nodes, (long long)st.surface_triangles);
     std::printf("  core: points %lld tets %lld steiner %lld\n", (long long)st.core_points, (long long)st.core_tets,
                 (long long)st.core_steiner_points);
+    std::printf("  refine points: Delaunay refinement %lld, interior splits %lld, collapses %lld\n",
+                (long long)st.refinement_points, (long long)st.interior_splits, (long long)st.collapses);
     std::printf("  refine: surface splits %lld, kept on shared faces %lld, projections refused %lld, mid-nodes "
                 "projected %lld straightened %lld, curved conflicts left %lld; merge: mid-nodes reconciled %lld "
                 "straightened %lld\n",

@@ -9,16 +9,21 @@
 // the same surface (exact mode) or of its projection (with a projection hook), see refine_mesh.h.
 //
 // Method (local operations, as in mmg or fTetWild; each one decided exactly by RefineMesh):
-//  1. size: edges longer than split_ratio * target are split at their midpoint, longest (relative
-//     to the target) first, until none is left or max_passes; surface edges too (exact points only,
-//     or through the projection hook). The target at a point is `size`, lowered near input faces
-//     whose tag has a size in `size_by_tag`, graded (grows by at most `grading` per unit length).
-//     Edges shorter than 2 * min_size are never split: this bounds the number of points, so the
-//     stage terminates whatever the input's angles (near small input angles it stops refining and
-//     the worst tets stay there);
+//  1. size, with a finite `size`: first Delaunay refinement (tets whose circumradius exceeds 0.9
+//     times their target get a point at their circumcentre, Bowyer-Watson, refused closer than
+//     0.8 times the target to the points of its cavity: the spacing rule that ends it); then
+//     edges still longer than split_ratio * target are split at their midpoint, longest
+//     (relative to the target) first, until none is left or max_passes; surface edges too (exact
+//     points only, or through the projection hook). The target at a point is `size`, lowered near
+//     input faces whose tag has a size in `size_by_tag`, graded (grows by at most `grading` per
+//     unit length). Edges shorter than 2 * min_size are never split: this bounds the number of
+//     points, so the stage terminates whatever the input's angles (near small input angles it
+//     stops refining and the worst tets stay there);
 //  2. optimization rounds: short edges collapsed (Steiner points only, within their support, never
-//     making the worst tet around worse), 2-3 and 3-2 flips and smoothing of interior points that
-//     raise the smallest dihedral angle locally, tets with a radius-edge ratio above the bound get
+//     making the worst tet around worse), ODT smoothing of every interior point (to the
+//     volume-weighted mean of its tets' circumcentres when the mean angle around it rises), 2-3
+//     and 3-2 flips, edge removals and smoothing of interior points that raise the smallest
+//     dihedral angle locally (tets below 35 degrees), tets with a radius-edge ratio above the bound get
 //     their shortest edge collapsed or their longest edge split, and tets below 15 degrees get a
 //     new interior point where it raises the worst angle of its Bowyer-Watson cavity (candidates:
 //     the apex of a regular tet over each of their faces, circumcentre, centroid; this lifts the
@@ -31,6 +36,9 @@
 //     (RefineMesh change stamps). Rounds stop when nothing changes
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
 //  2b. separate_face_tags (optional): see the option;
+//  2c. order 2 with a projection hook: room for curved elements (interior points lifted off the
+//     curved faces, or reconnected), then the tets below 15 degrees polished by flips, moves and
+//     collapses that raise the worst tet and make no valid curved element invalid;
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
 // Deterministic: edges and tets are visited in sorted order; no randomness.
 #pragma once
@@ -132,6 +140,7 @@ struct RefineStats {
   std::int64_t flat_collapses = 0;
   std::int64_t edge_removals = 0;        ///< n-to-2(n-2) flips, 4 <= n <= 7 (RefineMesh::remove_edge)
   std::int64_t insertions = 0;           ///< interior points inserted where they raise the worst angle
+  std::int64_t refinement_points = 0;    ///< interior points of the Delaunay refinement (size)
   std::int64_t size_passes = 0, optimize_rounds = 0;
   /// Edges of the result longer than split_ratio * the asked target (size, size_by_tag, graded;
   /// not raised around edges that could not be split).

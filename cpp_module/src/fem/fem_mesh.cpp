@@ -180,6 +180,9 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     }
     st.seconds_refine += seconds_since(t);
     st.surface_splits += rst.surface_splits;
+    st.refinement_points += rst.refinement_points;
+    st.interior_splits += rst.splits - rst.surface_splits;
+    st.collapses += rst.collapses;
     st.splits_fixed_surface += rst.splits_fixed_surface;
     st.projection_refused += rst.projection_rejected;
     st.midnodes_projected += rst.midnodes_projected;

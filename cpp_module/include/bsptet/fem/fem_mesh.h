@@ -84,6 +84,9 @@ struct FemStats {
   std::int64_t core_points = 0, core_tets = 0, core_steiner_points = 0;
   // Refinement (stage 3), summed over the solids.
   std::int64_t surface_splits = 0;        ///< points added on the surface (projected onto the CAD)
+  std::int64_t refinement_points = 0;     ///< interior points of the Delaunay refinement
+  std::int64_t interior_splits = 0;       ///< interior points of edge splits (what refinement left long)
+  std::int64_t collapses = 0;             ///< points removed by edge collapses
   std::int64_t splits_fixed_surface = 0;  ///< surface edges left on shared faces
   std::int64_t projection_refused = 0;    ///< hook answers the quality stage refused (see cad_projection.h)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2, per solid (tet10.h)
