@@ -123,9 +123,15 @@ def kill_session(pid):
 
 def run_measured(cmd, timeout, log_stem, env=None):
     """Run cmd in its own session; wall seconds, cpu seconds and peak memory of its process tree
-    (the larger of the biggest single process, from wait4, and the sampled sum of the tree).
-    stdout/stderr go to log_stem.out/.err. Ctrl-C kills the tree and propagates."""
+    (the larger of the biggest single process and the sampled sum of the tree).
+    stdout/stderr go to log_stem.out/.err. Ctrl-C kills the tree and propagates.
+    The biggest single process comes from GNU time (%M, the command's own peak RSS, its
+    waited-for children included), not from our wait4: the child we fork carries this script's
+    pages until it execs, so its ru_maxrss is at least our own size (about 200 MB with numpy,
+    meshio and the measured meshes loaded), whatever it runs."""
     err_path = log_stem + ".err"
+    maxrss_path = log_stem + ".maxrss"
+    cmd = ["/usr/bin/time", "-f", "%M", "-o", maxrss_path] + list(cmd)
     with open(log_stem + ".out", "wb") as out, open(err_path, "wb") as err:
         t0 = time.perf_counter()
         proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=out, stderr=err, env=env,
@@ -153,7 +159,12 @@ def run_measured(cmd, timeout, log_stem, env=None):
         raise
     proc.returncode = os.waitstatus_to_exitcode(done["status"])
     usage = done["usage"]
-    peak = max(sampled, usage.ru_maxrss * 1024)
+    try:
+        with open(maxrss_path) as f:
+            own_peak = int(f.read().split()[-1]) * 1024  # KB
+    except (OSError, ValueError, IndexError):  # killed at the time limit: no report
+        own_peak = 0
+    peak = max(sampled, own_peak)
     seconds = done["t"] - t0
     cpu = usage.ru_utime + usage.ru_stime
     if timed_out:  # the killed grandchildren's cpu time is lost (never reaped by their parent)
@@ -844,7 +855,7 @@ def how_measured_section(args):
             "(children included; – for a run stopped at the time limit, whose killed children "
             "are never reaped; FreeCAD's .geo sets gmsh's General.NumThreads to the number of "
             "cores, so gmsh may use more cpu than wall seconds); **peak MB** (10^6 bytes): the "
-            "larger of the biggest single process's peak RSS (wait4) and the sum of the RSS of "
+            "larger of the biggest single process's peak RSS (GNU time's %M) and the sum of the RSS of "
             "the run's process tree sampled every 50 ms (FreeCAD + the gmsh binary are two "
             "processes).", ""]
 
