@@ -37,9 +37,9 @@ constexpr double kRefineCircumradius = 0.9;
 constexpr double kRefineSpacing = 0.8;
 // The flip and smoothing passes of the optimization rounds work on the tets below this (or below
 // min_dihedral_deg when it is higher): above it a flip or a move rarely pays for its search
-// (flips up to 70 degrees took 3 to 6 times the refinement's time for a median 0.2 degree
+// (flips up to 70 degrees took 2 to 4 times the refinement's time for a median 0.2 degree
 // better; the ODT smoothing evens out the typical tet instead).
-constexpr double kFlipBelowDeg = 35.0;
+constexpr double kFlipBelowDeg = 40.0;
 using MoveAccept = std::function<bool(const std::vector<std::array<Vec3, 4>>&)>;
 
 // Face (A, B, C) of a tet whose fourth corner is D, for placing points over it.
@@ -697,7 +697,8 @@ class Refiner {
 
   // After the lifts (curved tet10 through a hook): the tets below `below` degrees, worst first,
   // get 3-2 and 2-3 flips, edge removals, moves of their interior corners (towards their
-  // neighbours' centroid, then steepest ascent) and collapses of their interior Steiner corners.
+  // neighbours' centroid, then steepest ascent), collapses of their interior Steiner corners and
+  // new interior points (insert_keeping_curved).
   // A change is applied when the worst tet it makes is better than the worst it replaces and the
   // curved elements it makes invalid are not more than those it removes (the lifts and insertions
   // for curved elements accept down to 1 degree; this takes the worst back up). Input points and
@@ -772,12 +773,57 @@ class Refiner {
             }
           }
         }
+        if (!done && insert_keeping_curved(t)) {
+          ++st_.insertions;
+          done = true;
+        }
         now += done;
       }
       changes += now;
       if (now == 0) break;
     }
     return changes;
+  }
+
+  // A new interior point for tet t (Bowyer-Watson, t forced into the cavity, the smallest angle
+  // of the new tets above the replaced ones', every new curved element valid): above each face
+  // of t at 1, 1/2 and 1/4 of a regular tet's height, then its circumcentre and centroid; no
+  // point closer than a quarter of t's mean edge to a corner of its cavity. What lifts a flat
+  // tet whose four corners lie on the surface, which no flip mends. True when one went in.
+  bool insert_keeping_curved(Index t) {
+    constexpr auto& kFace = kTetOppositeFace;  // types.h
+    const auto q = m_.tet(t);
+    const auto P = corner_points(q);
+    double mean = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) mean += length(q[i], q[j]) / 6;
+    std::vector<Vec3> cand;
+    for (int k = 0; k < 4; ++k) {
+      FaceFrame fr;
+      if (face_frame(P[kFace[k][0]], P[kFace[k][1]], P[kFace[k][2]], P[k], &fr))
+        for (double f : {1.0, 0.5, 0.25}) cand.push_back(fr.apex(f));
+    }
+    Vec3 cc;
+    double r2 = 0;
+    if (tet_circumsphere(P[0], P[1], P[2], P[3], &cc, &r2)) cand.push_back(cc);
+    cand.push_back({(P[0].x + P[1].x + P[2].x + P[3].x) / 4, (P[0].y + P[1].y + P[2].y + P[3].y) / 4,
+                    (P[0].z + P[1].z + P[2].z + P[3].z) / 4});
+    auto accept = [&](const std::vector<std::array<Index, 4>>& cone, const Vec3& p) {
+      for (const auto& c4 : cone) {
+        const std::array<Vec3, 4> C{m_.point(c4[0]), m_.point(c4[1]), m_.point(c4[2]), p};
+        if (!curved_element_ok(c4, C)) return false;
+      }
+      return true;
+    };
+    for (const Vec3& x : cand) {
+      if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) continue;
+      Index np = -1;
+      if (m_.insert_point(t, x, 0.25 * mean, &np, 256, true, accept, t) == InsertOutcome::kInserted) {
+        set_target(np, 0.25 * (target(q[0]) + target(q[1]) + target(q[2]) + target(q[3])));
+        return true;
+      }
+    }
+    return false;
   }
 
   // Moves interior point v where the worst tet around it gets better and no curved element
@@ -904,6 +950,9 @@ class Refiner {
     return n;
   }
 
+  // Flips around the tets below `below` degrees, worst first: 3-2 flips of their edges, 2-3 flips
+  // of their faces, edge removals (rings of 4 to kMaxEdgeRing), the first that raises the worst
+  // tet involved. Up to 4 sweeps while something changes; returns the flips made.
   std::int64_t flip_pass(double below) {
     std::int64_t flips = 0;
     std::vector<char> tried(static_cast<std::size_t>(m_.num_tet_slots()), 0);

@@ -23,7 +23,7 @@
 //     making the worst tet around worse), ODT smoothing of every interior point (to the
 //     volume-weighted mean of its tets' circumcentres when the mean angle around it rises), 2-3
 //     and 3-2 flips, edge removals and smoothing of interior points that raise the smallest
-//     dihedral angle locally (tets below 35 degrees), tets with a radius-edge ratio above the bound get
+//     dihedral angle locally (tets below 40 degrees), tets with a radius-edge ratio above the bound get
 //     their shortest edge collapsed or their longest edge split, and tets below 15 degrees get a
 //     new interior point where it raises the worst angle of its Bowyer-Watson cavity (candidates:
 //     the apex of a regular tet over each of their faces, circumcentre, centroid; this lifts the
