@@ -869,6 +869,21 @@ def _msh_elements(src, section, tags, points, rows_of):
 # --------------------------------------------------------------------------------------------
 
 
+def _inp_number(v):
+    """A coordinate for an .inp data line: the shortest round-trip repr when it fits in 20
+    characters, else rounded to the most significant digits that fit (14 at least). CalculiX
+    reads each entry as a 20-character field and refuses longer ones ("*ERROR reading *NODE"):
+    repr gives 23 for -3.5090841499628797e-16 or -0.00012345678901234567."""
+    text = repr(v)
+    if len(text) <= 20:
+        return text
+    for digits in range(16, 12, -1):
+        text = "%.*E" % (digits, v)
+        if len(text) <= 20:
+            return text
+    return text
+
+
 def _write_inp(path, points, tets, boundary):
     k = tets.shape[1]
     etype = "C3D4" if k == 4 else "C3D10"
@@ -878,8 +893,10 @@ def _write_inp(path, points, tets, boundary):
         out.write(f"** {len(points)} nodes, {m} {etype} elements; node order and orientation "
                   f"as CalculiX expects\n")
         out.write("*NODE, NSET=Nall\n")
-        out.write(_format_rows("%d, %r, %r, %r\n",
-                               _mixed_rows(np.arange(1, len(points) + 1), points)))
+        coords = np.empty(points.shape, dtype=object)
+        coords[:] = [[_inp_number(v) for v in row] for row in points.tolist()]
+        out.write(_format_rows("%d, %s, %s, %s\n",
+                               _mixed_rows(np.arange(1, len(points) + 1), coords)))
         out.write(f"*ELEMENT, TYPE={etype}, ELSET=Eall\n")
         rows = np.column_stack([np.arange(1, m + 1), tets + 1])
         # at most 16 entries per data line; a line ending in ',' continues on the next

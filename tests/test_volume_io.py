@@ -635,6 +635,24 @@ def test_calculix_accepts_our_inp_and_rejects_flipped(tmp_path, kind):
     assert bad.returncode != 0 or "nonpositive jacobian" in bad.stdout
 
 
+def test_inp_coordinates_fit_calculix_20_character_fields(tmp_path):
+    """CalculiX reads every entry of a data line as a 20-character field: a coordinate whose
+    round-trip repr is longer (-3.5090841499628797e-16, -0.00012345678901234567) made it stop
+    with "*ERROR reading *NODE". Such values are rounded to what fits (14 significant digits at
+    least); the others are written exactly."""
+    pts = np.array([[0.0, 0.0, 0.0], [1.0, -3.5090841499628797e-16, 0.0],
+                    [-0.00012345678901234567, 1.0, 0.0], [0.1, 0.2, 123.45678901234567]])
+    mesh = TetMesh(pts, np.array([[0, 1, 2, 3]]))
+    write_tet_mesh(tmp_path / "m.inp", mesh)
+    lines = (tmp_path / "m.inp").read_text().splitlines()
+    start = lines.index("*NODE, NSET=Nall") + 1
+    rows = [ln.split(",") for ln in lines[start:start + 4]]
+    assert all(len(f.strip()) <= 20 for row in rows for f in row)
+    back = np.array([[float(f) for f in row[1:]] for row in rows])
+    assert np.allclose(back, pts, rtol=1e-13, atol=0)
+    assert back[3, 2] == 123.45678901234567 and back[3, 0] == 0.1  # short ones exact
+
+
 # ------------------------------------------------------------------------------------------
 # errors
 # ------------------------------------------------------------------------------------------
