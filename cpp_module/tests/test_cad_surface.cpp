@@ -34,6 +34,7 @@
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/cad/cad_surface.h"
 #include "bsptet/errors.h"
+#include "bsptet/self_intersection.h"
 
 using namespace bsptet;
 
@@ -138,6 +139,25 @@ TEST(CadSurface, BracketHolesAndFilletAreUniform) {
   const cad::CadSurface s = mesh_and_check(model);
   // At h = diagonal / 20 the bracket needs a couple of thousand triangles, not tens of thousands.
   EXPECT_LT(s.solid_tag[0].size(), 6000u);
+}
+
+TEST(CadSurface, ThreadStripWindingAroundItsAxisMeshesWithoutCrossings) {
+  // The OCCT tutorial bottle: its thread's lower flank (Face4) is a B-spline strip 0.4 mm wide
+  // that winds twice around the neck while u runs over [0, pi], so nodes close in (u, v) are a
+  // whole turn apart on the surface; an ear-cut start judged by its 3D chords folded through the
+  // neck. The surface must come out free of crossing triangles.
+  const cad::CadModel model = cad::read_cad_file(data("cad/bottle.brep"));
+  cad::CadSurfaceStats stats;
+  const cad::CadSurface s = cad::mesh_cad_surface(model, {}, &stats);
+  ASSERT_EQ(s.solid_tri.size(), 1u);
+  bool complete = true;
+  const auto pairs = find_self_intersections(s.solid_surface(0), 10, &complete);
+  EXPECT_TRUE(pairs.empty()) << pairs.size() << " crossing pairs, the first triangles " << pairs[0][0] << " and "
+                             << pairs[0][1];
+  // The strip's end creases (its normal turns by more than 90 degrees within 1% of its u
+  // range): the few triangles there that oppose one corner's normal are the only folds.
+  for (const auto& [face, folds] : stats.folded_faces) EXPECT_EQ(face, 3) << "Face" << face + 1 << ": " << folds;
+  EXPECT_LT(stats.folds, stats.triangles / 1000);
 }
 
 TEST(CadSurface, TwoSolidsWithSeams) {

@@ -167,6 +167,26 @@ class FaceMesher {
     return edges;
   }
 
+  /// First fundamental form (E, F, G) of the surface at uv: |S_u|^2, S_u . S_v, |S_v|^2.
+  std::array<double, 3> metric(const Uv& uv) const {
+    gp_Pnt p;
+    gp_Vec du, dv;
+    surface_.D1(uv[0], uv[1], p, du, dv);
+    return {du.Dot(du), du.Dot(dv), dv.Dot(dv)};
+  }
+  /// Shape quality of the (u, v) triangle (a, b, c) in the constant metric m (1 equilateral in
+  /// that metric; its sign is the (u, v) orientation's).
+  static double metric_shape(const Uv& a, const Uv& b, const Uv& c, const std::array<double, 3>& m) {
+    auto len2 = [&](const Uv& p, const Uv& q) {
+      const double du = q[0] - p[0], dv = q[1] - p[1];
+      return m[0] * du * du + 2 * m[1] * du * dv + m[2] * dv * dv;
+    };
+    const double cross_uv = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    const double l2 = len2(a, b) + len2(b, c) + len2(c, a);
+    const double det = std::max(0.0, m[0] * m[2] - m[1] * m[1]);
+    return l2 > 0 ? 2 * std::sqrt(3.0) * cross_uv * std::sqrt(det) / l2 : 0;
+  }
+  int metric_flip_pass();
   bool split(int a, int b, bool untangle = false);
   bool flip(int a, int b, bool in_3d = false);
   int untangle_pass();
@@ -395,6 +415,47 @@ int FaceMesher::flip_pass() {
   return total;
 }
 
+/// The start triangulation's folded triangles flipped in the surface's metric rather than in 3D:
+/// a quad (two triangles on an edge) with a triangle folded in 3D is measured in the first
+/// fundamental form at its (u, v) centroid, and its diagonal is flipped when that raises the
+/// smaller metric shape of its two triangles (Lawson's order, as flip_pass). Ear cutting joins
+/// boundary nodes that are close in (u, v) but may be far apart on the surface (a thread's strip
+/// winds around its axis over a short u interval); such a fan is folded in 3D almost everywhere,
+/// where a flip judged on the 3D chords has nothing better to go to, while in the metric every
+/// flip heads for the triangulation the surface's own lengths ask for. Quads with no fold are
+/// left to flip_pass, and quads with a pole corner too (the metric degenerates there).
+int FaceMesher::metric_flip_pass() {
+  std::vector<std::pair<int, int>> stack = interior_edges();
+  std::reverse(stack.begin(), stack.end());
+  const std::size_t cap = 50 * tris_.size() + 1000;
+  int total = 0;
+  while (!stack.empty() && static_cast<std::size_t>(total) < cap) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const auto [t0, t1] = edge_tris(a, b);
+    if (t0 < 0 || t1 < 0) continue;
+    const int c = opposite(tris_[static_cast<std::size_t>(t0)], a, b);
+    const int d = opposite(tris_[static_cast<std::size_t>(t1)], a, b);
+    if (c == d || seam_pair(c, d)) continue;
+    if (verts_[a].pole || verts_[b].pole || verts_[c].pole || verts_[d].pole) continue;
+    if (quality(a, b, c) > 0 && quality(b, a, d) > 0) continue;  // neither folded: left to flip_pass
+    if (!valid(a, d, c) || !valid(d, b, c)) continue;
+    const Uv &ua = verts_[a].uv, &ub = verts_[b].uv, &uc = verts_[c].uv, &ud = verts_[d].uv;
+    const auto m = metric({0.25 * (ua[0] + ub[0] + uc[0] + ud[0]), 0.25 * (ua[1] + ub[1] + uc[1] + ud[1])});
+    const double before = std::min(metric_shape(ua, ub, uc, m), metric_shape(ub, ua, ud, m));
+    const double after = std::min(metric_shape(ua, ud, uc, m), metric_shape(ud, ub, uc, m));
+    if (!(after > before)) continue;
+    kill_tri(t0);
+    kill_tri(t1);
+    add_tri({a, d, c});
+    add_tri({d, b, c});
+    ++total;
+    for (const auto& e : {std::make_pair(a, c), std::make_pair(c, b), std::make_pair(b, d), std::make_pair(d, a)})
+      stack.push_back(e);
+  }
+  return total;
+}
+
 /// Triangles that still face against the surface (a fold: the start's ear-cut triangles near a
 /// pole or across a strongly curved patch) are flipped away judged in 3D alone (both new
 /// triangles must face the surface's way), or collapsed, or split, whichever raises the worst
@@ -463,7 +524,8 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
   }
   for (const auto& t : triangulate_polygon(uv, index_loops)) add_tri({t[0], t[1], t[2]});
 
-  flip_pass();  // the ear-cut fan into a better-shaped start: splits then spread points evenly
+  metric_flip_pass();  // the ear-cut fan's folds into the surface's own shapes,
+  flip_pass();         // then into better 3D shapes: splits then spread points evenly
   for (int round = 0; round < options_.max_rounds; ++round) {
     const int splits = split_pass();
     flip_pass();

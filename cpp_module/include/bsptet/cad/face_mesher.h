@@ -6,7 +6,10 @@
 // Gmsh's MeshAdapt does):
 //  1. the boundary loops (the nodes of the face's edges, at their pcurve parameters) are
 //     triangulated in (u, v) by ear cutting (uv_polygon.h), and that fan is flipped towards
-//     better shapes;
+//     better shapes: where a triangle is folded in 3D, first measured in the surface's metric
+//     (the first fundamental form at each quad's (u, v) centroid: nodes close in (u, v) may be
+//     far apart on the surface, and a fan of such triangles is folded almost everywhere), then
+//     everywhere in 3D;
 //  2. rounds of local operations, each kept only when every triangle it makes is valid (below):
 //     interior edges longer than 1.4 times the local size are split at their (u, v) midpoint
 //     (the new node evaluated on the surface), edges shorter than 0.7 times it are collapsed onto
@@ -26,9 +29,10 @@
 // copies of one seam node (u = 0 and u = period) must never share a triangle: such edges are
 // split or flipped away.
 //
-// Known limits: near a pole or a cone apex, and on strongly twisted B-spline patches, a few
-// triangles may stay folded (FaceMesh::folds counts them); the volume stage then refuses the
-// surface, naming the crossing triangles.
+// Known limits: near a pole or a cone apex, and where a B-spline face creases within itself
+// (its normal turning by more than 90 degrees over a few triangles), a few triangles may stay
+// folded (FaceMesh::folds counts them); if they cross another triangle, the volume stage
+// refuses the surface, naming the crossing triangles.
 //
 // Orientation: triangles turn counter-clockwise in (u, v) of the FORWARD face, so their right-hand
 // normal is the surface's S_u x S_v; the caller reverses them for a face REVERSED in its solid.
