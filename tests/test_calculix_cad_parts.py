@@ -14,7 +14,7 @@ from FemBspTet.fem.cad_mesh import mesh_cad_file
 from FemBspTet.fem.calculix_load_case import _face_nodes, _read_displacements, solve_face_load
 
 DATA = os.path.join(os.path.dirname(__file__), "data", "cad")
-PARTS = ["bracket.step", "red_cube_blue_cylinder.step"]
+PARTS = ["bracket.step", "red_cube_blue_cylinder.step", "bottle.brep"]
 
 if shutil.which("ccx") is None:
     pytest.fail("ccx is a declared dependency: run scripts/setup.sh", pytrace=False)

@@ -29,7 +29,7 @@ constexpr int kMaxEdgeRing = 7;
 // Tets below this are polished once the curved elements have room (Refiner::polish_curved).
 constexpr double kPolishCurvedBelowDeg = 15.0;
 // ODT smoothing (Refiner::odt_smooth_pass) never takes a tet below this or below the worst before.
-constexpr double kOdtKeepDeg = 30.0;
+constexpr double kOdtKeepDeg = 15.0;
 // Delaunay refinement (Refiner::delaunay_refine_phase): tets with a circumradius above this times
 // the target get a point; none lands closer than kRefineSpacing times the target to the points
 // of its cavity. A regular tet of edge h has circumradius 0.61 h.
