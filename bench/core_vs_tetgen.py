@@ -31,7 +31,8 @@ def main(argv=None):
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--repeats", type=int, default=5,
                     help="runs shorter than 1 s are made this many times; their median is used")
-    ap.add_argument("--markdown", default=None, help="also write the report as markdown here")
+    ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "core-vs-tetgen.md"),
+                    help="also write the report as markdown here")
     args = ap.parse_args(argv)
     paths = model_paths(args.models or [os.path.join(ROOT, "tests/data/paper"),
                                         os.path.join(ROOT, "tests/data/corpus")])

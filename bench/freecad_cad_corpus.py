@@ -30,7 +30,7 @@ def main():
     ap.add_argument("inputs", nargs="*", default=[os.path.join(ROOT, "tests", "data", "cad")])
     ap.add_argument("--order", type=int, choices=(1, 2), default=1)
     ap.add_argument("--timeout", type=float, default=120.0)
-    ap.add_argument("--markdown", default=None)
+    ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "freecad-cad-corpus.md"))
     ap.add_argument("--size-of-diagonal", type=float, default=0.0, metavar="F",
                     help="CharacteristicLengthMax = F * the shape's bounding-box diagonal "
                          "(default 0: automatic, the mesher object's default)")

@@ -105,7 +105,7 @@ def main(argv=None):
     ap.add_argument("--timeout", type=float, default=1800.0)
     ap.add_argument("--keep", default=None, metavar="DIR")
     ap.add_argument("--check", action="store_true")
-    ap.add_argument("--markdown", default=None)
+    ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "out-of-core.md"))
     ap.add_argument("--note", action="append", default=[])
     args = ap.parse_args(argv)
     command = "bench/out_of_core.py " + shlex.join(sys.argv[1:] if argv is None else argv)

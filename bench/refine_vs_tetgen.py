@@ -69,8 +69,8 @@ def main():
     ap.add_argument("--divisions", type=float, default=20.0)
     ap.add_argument("--modes", default="exact,rounded")
     ap.add_argument("--timeout", type=float, default=600.0)
-    ap.add_argument("--png", default=os.path.join(ROOT, "out", "refine_vs_tetgen.png"))
-    ap.add_argument("--markdown", default=None)
+    ap.add_argument("--png", default=os.path.join(ROOT, "docs", "benchmarks", "refine-vs-tetgen.png"))
+    ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "refine-vs-tetgen.md"))
     ap.add_argument("--json", default=None, help="write every row (unrounded figures, histograms) here")
     args = ap.parse_args()
     modes = [m for m in args.modes.split(",") if m]

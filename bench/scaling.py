@@ -542,9 +542,9 @@ def main(argv=None):
                     help="also run our exact checker on every mesh (untimed)")
     ap.add_argument("--no-validate", action="store_true",
                     help="skip the core's exact check of the generated surfaces")
-    ap.add_argument("--png", default=None)
-    ap.add_argument("--json", default=None, help="the raw rows")
-    ap.add_argument("--markdown", default=None)
+    ap.add_argument("--png", default=os.path.join(ROOT, "docs", "benchmarks", "scaling.png"))
+    ap.add_argument("--json", default=os.path.join(ROOT, "docs", "benchmarks", "scaling.json"), help="the raw rows")
+    ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "scaling.md"))
     ap.add_argument("--from-json", default=None, metavar="FILE",
                     help="run nothing: print and write the table, plot and report of a JSON "
                          "file an earlier run wrote with --json")
