@@ -441,7 +441,7 @@ def test_sizes_and_estimates():
             parse_size(bad)
     small, big = estimate_peak_bytes(100, 200), estimate_peak_bytes(10000, 20000)
     assert small < big
-    # The estimate stays above the typical measured peaks (docs/bad-input.md): spot, 5856
+    # The estimate stays above the typical measured peaks (docs/design/bad-input.md): spot, 5856
     # triangles, 36.5 MiB through the CLI; the 10^6-triangle bottle, 1.0 GiB in bsptet_mesh.
     assert estimate_peak_bytes(2930, 5856) > 37 << 20
     assert estimate_peak_bytes(503157, 1006310) > 1100 << 20

@@ -44,9 +44,9 @@ def test_bottle_at_deflection_diag200_meshes_after_retries():
     s = _bottle()
     mesh, stats = core.tetrahedralize(s, {"bsp_seed": "box"})
     _valid_without_surface_steiner(s, mesh)
-    # The path it takes today: the first attempt and the one along lines fail, shift 1 makes the
-    # mesh. If an earlier attempt starts to succeed, update these
-    # figures (and docs/core-design.md).
+    # The path it takes: the first attempt and the one along lines fail, shift 1 makes the mesh
+    # (the retries of docs/design/core.md). If a prior attempt starts to succeed, update these
+    # figures.
     assert stats["bsp_seed"] == "box"
     assert stats["retries"] == 2
     assert stats["bsp_candidate_shift"] == 1

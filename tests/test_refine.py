@@ -214,7 +214,7 @@ def test_tet10_of_a_thin_tube_is_valid_and_counts_every_mid_node_left_off_the_su
     Jacobians, and every boundary mid-node either on the analytic surfaces (1e-9) or counted in
     ``midnodes_straightened``. The
     thinner walls (10 and 6 segments) still leave straightened mid-nodes: no interior point
-    makes room there yet (docs/quality-stage.md)."""
+    makes room there yet (docs/design/quality-stage.md)."""
     surface = tube(1.0, inner, height, segments)
     mesh, stats = core.tetrahedralize(
         surface, options={"order": 2, "projection": tube_projection(1.0, inner, height),
