@@ -7,8 +7,8 @@ distance to the CAD, whole-process time and peak memory. Usage:
                           [--ours-args ARGS]
                           [--out-dir DIR] [--json FILE] [--workdir DIR]
 
-PART: STEP/BREP/IGES files or folders of them (default: every CAD file of
-/work/shared/data/corpus/cad plus resources/samples/bracket.step). For each part and each D
+PART: STEP/BREP/IGES files or folders of them (default: every CAD file of the public CAD
+corpus folder, CORPUS_DIR below, plus resources/samples/bracket.step). For each part and each D
 (default 20 40), h = bounding-box diagonal / D, and each mesher runs as its own process with a
 time limit:
 

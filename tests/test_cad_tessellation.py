@@ -1,6 +1,6 @@
 """Tests of FemBspTet.cad_tessellation (FreeCAD shapes and CAD files -> face-tagged surfaces).
 
-Run with Debian's interpreter: ``cd /work/main && /usr/bin/python3 -m pytest -q tests``.
+Run with Debian's interpreter from the checkout: ``/usr/bin/python3 -m pytest -q tests``.
 Skipped when FreeCAD (Debian package freecad-python3) is not available. The invariants are
 checked with helpers written here, independent of the module's own checks.
 """

@@ -1,6 +1,6 @@
 """Tests of FemBspTet.freecad_export (TetMesh <-> Fem.FemMesh, mesh files through FreeCAD).
 
-Run with Debian's interpreter: ``cd /work/main && /usr/bin/python3 -m pytest -q tests``.
+Run with Debian's interpreter from the checkout: ``/usr/bin/python3 -m pytest -q tests``.
 Skipped when FreeCAD (Debian package freecad-python3) is not available.
 """
 
