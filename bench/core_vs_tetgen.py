@@ -11,7 +11,8 @@ nodes, tets, Steiner points, dihedral angles, seconds and peak memory of each me
 process, whether our exact checker accepts each mesh, then the ratios against TetGen and their
 medians. ``fembsptet benchmark`` adds Gmsh. ``--repeats N`` (default 5): a run shorter than a
 second is made N times in all and timed by the median (single runs of a few milliseconds vary by
-tens of percent on a shared machine, and most of the models here are that small).
+tens of percent on a shared machine, and most of the models here are that small). The report goes
+to docs/benchmarks/core-vs-tetgen.md unless --markdown says otherwise.
 """
 
 import argparse

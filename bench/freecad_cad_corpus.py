@@ -6,7 +6,8 @@ Usage:
     bench/freecad_cad_corpus.py [FOLDER_OR_FILES ...] [--order 1|2] [--size-of-diagonal F]
                                 [--timeout S] [--markdown F]
 
-Default folder: tests/data/cad. Prints one row per file.
+Default folder: tests/data/cad. Prints one row per file; --markdown (default
+docs/benchmarks/freecad-cad-corpus.md) writes them as a report.
 """
 
 import argparse

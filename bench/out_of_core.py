@@ -19,7 +19,7 @@ timed by ``FemBspTet.compare.process.run_measured`` (wall time, peak RSS from GN
 
 ``--check`` reads every mesh back and checks it exactly against the input surface (untimed).
 Prints a table: seconds, peak MB, the peak's ratio to the budget and to the in-memory run, tets,
-pieces, and validity.
+pieces, and validity; --markdown (default docs/benchmarks/out-of-core.md) writes it as a report.
 """
 
 import argparse

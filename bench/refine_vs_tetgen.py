@@ -15,7 +15,8 @@ input surface for a mesh without boundary Steiner points, else against the mesh'
 Printed per model: validity, tets, min / 1st percentile dihedral angle, seconds, and the ratios
 ours / TetGen; then the share of models where our min dihedral >= TetGen's, how many tet counts
 are within +-20 %, and the median count ratio. The PNG puts the dihedral histograms side by side.
-Models the core cannot mesh are listed with the core's message.
+Models the core cannot mesh are listed with the core's message. Default outputs:
+docs/benchmarks/refine-vs-tetgen.md and docs/benchmarks/refine-vs-tetgen.png.
 """
 
 import argparse

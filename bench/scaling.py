@@ -36,7 +36,8 @@ Prints the table (seconds and peak MB per mesher, ratios ours / tetgen -pY) and 
 growth exponents: the least-squares slope of log(seconds) and log(peak MB) against
 log(triangles) over the finished sizes, per mesher and family (fewer than 3 finished sizes:
 "n/a (k points)"). --png draws both on log-log axes; --json writes the raw rows; --markdown a
-report with the command, the machine, the versions, the table and the exponents.
+report with the command, the machine, the versions, the table and the exponents (defaults:
+docs/benchmarks/scaling.png, .json and .md).
 """
 
 import argparse
