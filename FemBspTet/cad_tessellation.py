@@ -3,7 +3,7 @@
 Every triangle carries the CAD face it was made from, so the mesh boundary can be matched to the
 names FreeCAD constraints reference (``"Face7"``).
 
-Method (``/work/shared/design/freecad.md`` section 2):
+Method (FreeCAD 0.20.2's Part module and OpenCASCADE's BRepMesh):
 
 1. The shape is copied (``shape.copy()``: same topology and sub-shape order, no stored
    triangulation), so the caller's shape is never modified.

@@ -7,8 +7,8 @@
   - FreeCAD 1.x: a workbench manipulator puts the command right after FEM's Gmsh command in
     FEM's Mesh toolbar and Mesh menu.
   - FreeCAD 0.20/0.21 (no manipulators; FEM is a C++ workbench): a custom toolbar "BspTet"
-    defined by parameters, which FEM shows on activation (``/work/shared/design/freecad.md``
-    §9), and an entry appended to FEM's "Mesh" menu each time FEM is activated.
+    defined by parameters, which FEM shows on activation (its workbench reads
+    the toolbars stored under its parameter group), and an entry appended to FEM's "Mesh" menu each time FEM is activated.
 """
 
 import os

@@ -1,7 +1,7 @@
 """Import FreeCAD on demand: inside FreeCAD itself, or headless in Debian's ``/usr/bin/python3``.
 
 Nothing here imports FreeCAD at module import time; call :func:`import_freecad` where FreeCAD is
-needed. The headless bootstrap follows ``/work/shared/design/freecad.md`` section 1 (FreeCAD 0.20.2
+needed. The headless bootstrap is the one FreeCAD's own console uses (FreeCAD 0.20.2
 from Debian 12, package ``freecad-python3``):
 
 * ``/usr/lib/freecad-python3/lib`` holds ``FreeCAD.so`` and the compiled modules (``Part``, ``Fem``,

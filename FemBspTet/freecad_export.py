@@ -1,7 +1,7 @@
 """Convert between :class:`~FemBspTet.mesh_types.TetMesh` and FreeCAD's ``Fem.FemMesh``, and write
 or read mesh files through FreeCAD's own writers and readers.
 
-Conventions (``/work/shared/design/freecad.md`` section 3):
+Conventions (FreeCAD 0.20.2's FemMesh, SMESH underneath):
 
 * Our tets are positively oriented, ``det[b - a, c - a, d - a] > 0``; SMESH (FreeCAD's FemMesh)
   uses the opposite sign, ``(p2 - p1) x (p3 - p1) . (p4 - p1) < 0``. Converting swaps corners 1

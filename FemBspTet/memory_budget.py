@@ -5,7 +5,7 @@
     require_within_budget(surfaces, budget)           # MemoryBudgetError if the estimate exceeds it
 
 The estimate is the typical peak with margin: about 1 to 3 KiB per input triangle measured from
-10^3 to 10^6 triangles (``docs/bad-input.md``), taken as 4 KiB, plus the
+10^3 to 10^6 triangles (``docs/design/bad-input.md``), taken as 4 KiB, plus the
 interpreter's share. The BSP's size depends on the geometry, not only on the counts (inputs
 whose triangles cross many seed tets reach tens of KiB per triangle), so it is only a first
 filter: the supervised CLI also watches the run's real resident memory against the same budget
@@ -24,7 +24,7 @@ __all__ = ["estimate_peak_bytes", "parse_size", "default_budget", "require_withi
 
 #: Fixed cost of a run: the Python interpreter, numpy, the core's tables (bytes).
 BASE_BYTES = 96 << 20
-#: Typical peak per input triangle with margin (bytes); see docs/bad-input.md. The measured
+#: Typical peak per input triangle with margin (bytes); see docs/design/bad-input.md. The measured
 #: peak grows no faster than the triangle count (memory exponents 0.85 to 0.97, 10^4 to 10^6).
 BYTES_PER_TRIANGLE = 4 << 10
 

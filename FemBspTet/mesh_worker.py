@@ -1,5 +1,5 @@
 """Meshing in a separate process, so that FreeCAD's GUI never freezes and a crash of the core
-cannot take FreeCAD down (``/work/shared/design/style.md`` §3.15).
+cannot take FreeCAD down.
 
 Client side (GUI thread, or any script)::
 

@@ -1,5 +1,5 @@
 """The BspTet mesher document object: ``Fem::FemMeshObjectPython`` with proxy type
-``Fem::FemMeshBspTet`` (``/work/shared/design/freecad.md`` §4).
+``Fem::FemMeshBspTet``, made the way FreeCAD 0.20.2 makes its Gmsh and Netgen mesh objects.
 
     obj = make_mesher(doc, part, CharacteristicLengthMax=500, ElementOrder="2nd")
     FemBspTet.run_mesher(obj)            # meshes it (mesher_tools); recompute never meshes

@@ -42,7 +42,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3"  # Debian's: FreeCAD's module loads only there
 OURS_CLI = os.path.join("bin", "fembsptet")  # relative to ROOT
-CORPUS_DIR = "/work/shared/data/corpus/cad"
+CORPUS_DIR = os.path.join(os.path.dirname(ROOT), "shared", "data", "corpus", "cad")  # beside the checkout
 BRACKET = os.path.join(ROOT, "resources", "samples", "bracket.step")
 CAD_EXTENSIONS = (".step", ".stp", ".brep", ".brp", ".iges", ".igs")
 MESHERS = ("ours", "gmsh", "netgen")

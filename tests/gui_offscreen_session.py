@@ -14,7 +14,8 @@ import traceback
 import zipfile
 
 facts = {"errors": []}
-out_path = os.environ.get("FEMBSPTET_GUI_OUT", "/tmp/fembsptet_gui_out.json")
+out_path = os.environ.get("FEMBSPTET_GUI_OUT",
+                          os.path.join(tempfile.gettempdir(), "fembsptet_gui_out.json"))
 
 
 def step(name):

@@ -1,7 +1,7 @@
 """The comparison over a folder of models, as a markdown report (``fembsptet benchmark``).
 
     entries = run_benchmark(model_paths(["tests/data/corpus"]), timeout=300)
-    write_report("docs/compare-report.md", entries, command="fembsptet benchmark ...")
+    write_report("out/compare-report.md", entries, command="fembsptet benchmark ...")
 
 Each model is read (a CAD file is tessellated once, as ``fembsptet mesh`` does) and given to
 :func:`.comparison.compare`; every mesher run has the time limit ``timeout`` (a run over it is a
@@ -197,7 +197,8 @@ def environment():
 
 
 def _short_message(message):
-    """``message`` without the comparison's temporary folder (``/tmp/fembsptet_compare_*/``)."""
+    """``message`` without the comparison's temporary folder (``fembsptet_compare_*/`` in the
+    system's temporary directory)."""
     import re
     import tempfile
 

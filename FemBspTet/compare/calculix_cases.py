@@ -2,7 +2,7 @@
 with our mesh and with FreeCAD's Gmsh mesh at the same size.
 
 * ``cantilever``: steel box 8000 x 1000 x 1000 mm, Face1 (x = 0) fixed, 9e6 N in -z on Face2
-  (x = L) (``/work/shared/design/freecad.md`` §6; Gmsh tet10 at size 500: 88.15 mm).
+  (x = L) (FreeCAD's own cantilever example; Gmsh tet10 at size 500: 88.15 mm).
 * ``plate_with_hole``: steel plate 200 x 100 x 10 mm with a hole of radius 20 mm through its
   centre, Face1 (x = 0) fixed, 100 MPa pressure on the hole's cylindrical face.
 

@@ -403,7 +403,7 @@ static TetMesh tetrahedralize_attempts(const SurfaceMesh& input, const MeshOptio
                                        bool surface_checked) {
   const auto t_start = Clock::now();
   // The Steiner removal can get stuck on a surface point it cannot move inside (a fan of slivers
-  // from planes that pass within rounding of each other, docs/core-design.md). Another complex has
+  // from planes that pass within rounding of each other, docs/design/bsp-cells.md). Another complex has
   // other points and usually goes through: first the other refinement of the covered faces, then
   // other partitions (BspComplex::set_candidate_shift 1, 2), each as valid as the first. Anything
   // else (bad input, cancelled, other stages) is reported as it is, and so is the last attempt's

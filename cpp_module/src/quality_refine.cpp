@@ -531,7 +531,7 @@ class Refiner {
   // min(1 degree, the worst before): a valid curved mesh is worth a worse linear angle there.
   // Failing that, a new interior point above one of the tet's faces (Bowyer-Watson), accepted when
   // all its new tets are valid curved elements of at least 1 degree. Splitting the sagging edges
-  // instead was tried and made more invalid elements (docs/quality-stage.md). Sets
+  // instead was tried and made more invalid elements (docs/design/quality-stage.md). Sets
   // curving_conflicts_left.
   void lift_for_curved_elements() {
     if (!o_.projection || o_.order != 2) return;

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string off = argv[1], expect = argv[2];
-  char tmpl[] = "/tmp/bsptet_corpus_XXXXXX";
-  if (!mkdtemp(tmpl)) return 2;
+  std::string tmpl = (std::filesystem::temp_directory_path() / "bsptet_corpus_XXXXXX").string();
+  if (!mkdtemp(tmpl.data())) return 2;
   const std::filesystem::path dir(tmpl);
   int status = 1;
   try {

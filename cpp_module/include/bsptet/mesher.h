@@ -32,8 +32,8 @@ struct MeshOptions {
   /// Delaunay, cell_tetrahedralize.h CellFill::kCone) instead of the default per-cell Delaunay
   /// (paper Sec. 2.3). For comparison.
   bool cone_cells = false;
-  /// Refine the faces on input planes along whole input edge lines (the refinement before session
-  /// 6; bsp_complex.h refine_covered_faces_along_lines) instead of one piece per input triangle.
+  /// Refine the faces on input planes along whole input edge lines (bsp_complex.h
+  /// refine_covered_faces_along_lines) instead of one piece per input triangle.
   /// tetrahedralize() retries with it by itself when the Steiner removal gets stuck.
   bool covered_faces_along_lines = false;
   /// What the BSP starts from (bsp_complex.h BspSeed): kDelaunay, the Delaunay tetrahedralization

@@ -1,6 +1,6 @@
 // FemBspTet core: the out-of-core mode. The paper (Sec. 4.3) swaps completed cells to disk; this
-// core's peak is in its Delaunay seed, before any cell is complete (docs/core-design.md, session
-// 22), so instead the SOLID is cut into pieces small enough for the memory, each piece is meshed
+// core's peak is in its Delaunay seed, before any cell is complete (docs/design/out-of-core.md),
+// so instead the SOLID is cut into pieces small enough for the memory, each piece is meshed
 // whole by tetrahedralize (mesher.h) and spooled to disk, and the pieces are streamed into one
 // TetGen .node/.ele pair. Peak memory: the largest piece's run plus the input surface.
 //

@@ -81,7 +81,7 @@ struct RefineOptions {
   /// maximum). Midpoint bisection leaves points much closer than the longest edge: with 1.4 the
   /// median edge came out at 0.56 h and 4 to 9 times Gmsh's tets at its CharacteristicLengthMax
   /// = h; with 2.0 (and the collapses below) the median edge is about 0.8 h, Gmsh's 1.0 h (its
-  /// edges reach 2 h), and the counts 1.2 to 3 times Gmsh's (docs/quality-stage.md).
+  /// edges reach 2 h), and the counts 1.2 to 3 times Gmsh's (docs/design/quality-stage.md).
   double split_ratio = 2.0;
   /// Edges shorter than collapse_ratio * target are collapsed where a Steiner point can go (never
   /// making an edge longer than split_ratio * target, and see collapse_min_dihedral_deg).

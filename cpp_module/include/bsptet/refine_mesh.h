@@ -192,7 +192,7 @@ class RefineMesh {
   /// than 180 degrees (the edge is not locally Delaunay in its facet).
   /// The quality driver does not call it yet: in its flip pass (rounded mode, 6 CAD models at
   /// h = diagonal / 20) it raised the worst angle on some models and lowered it on others, with or
-  /// without the Delaunay condition (docs/quality-stage.md).
+  /// without the Delaunay condition (docs/design/quality-stage.md).
   bool flip_boundary_edge(Index u, Index v, int max_ring = 7, const TetsAccept& accept = {},
                           bool only_if_not_delaunay = false);
   /// Inserts a new interior point p, Bowyer-Watson style. p is located by a visibility walk from
