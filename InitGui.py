@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # FemBspTet: FreeCAD start-up (GUI side). exec()'d by FreeCAD inside a function: no __file__, and
 # top-level names are locals, so everything the workbench needs is imported inside its methods.
 # At start-up: the command FEM_MeshBspTetFromShape is registered, put into FEM's toolbar and menu

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # FemBspTet's App tests for FreeCAD's own test runner (registered in Init.py):
 #     freecadcmd -t TestFemBspTetApp
 # A quick check that the addon works inside FreeCAD's interpreter: the mesher object meshes a

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """FemBspTet: BSP-assisted constrained tetrahedralization for FreeCAD FEM.
 
 The compiled core is the private extension ``FemBspTet._bsptet`` (built by ``scripts/setup.sh``).

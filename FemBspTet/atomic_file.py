@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Atomic file output: a file of the target name appears only complete, or not at all.
 
 A writer opens :func:`atomic_output` (or :func:`atomic_outputs` for formats made of several

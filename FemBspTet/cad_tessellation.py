@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CAD solids (FreeCAD ``Part.Shape``, STEP / BREP / IGES files) -> closed, face-tagged surfaces.
 
 Every triangle carries the CAD face it was made from, so the mesh boundary can be matched to the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The ``fembsptet`` command line.
 
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]

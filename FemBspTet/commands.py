@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """GUI command ``FEM_MeshBspTetFromShape`` and its places in FreeCAD's FEM workbench.
 
 * The command (one selected shape) creates the mesher object through ``FreeCADGui.doCommand``

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The numpy API of FemBspTet: meshing and checking. Never imports FreeCAD.
 
     from FemBspTet import core

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Typed errors of FemBspTet.
 
 Every error names what is wrong and where (file, line, triangle or vertex index, CAD face) and,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Import FreeCAD on demand: inside FreeCAD itself, or headless in Debian's ``/usr/bin/python3``.
 
 Nothing here imports FreeCAD at module import time; call :func:`import_freecad` where FreeCAD is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Convert between :class:`~FemBspTet.mesh_types.TetMesh` and FreeCAD's ``Fem.FemMesh``, and write
 or read mesh files through FreeCAD's own writers and readers.
 

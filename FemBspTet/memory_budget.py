@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Memory budget of a meshing run: an estimate before it starts, sizes as people write them.
 
     from FemBspTet.memory_budget import estimate_peak_bytes, parse_size, require_within_budget

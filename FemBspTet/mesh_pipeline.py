@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CAD shape -> FEM mesh for the FreeCAD mesher object: the FEM path
 (:func:`FemBspTet.fem.cad_mesh.mesh_cad_brep`) on the shape's BREP, and what the object needs
 around it, without any document object.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Plain numpy containers passed between the readers, the core, the checker and the writers.
 
 Conventions (stated once, here):

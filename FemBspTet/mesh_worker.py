@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Meshing in a separate process, so that FreeCAD's GUI never freezes and a crash of the core
 cannot take FreeCAD down.
 

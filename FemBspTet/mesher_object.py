@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The BspTet mesher document object: ``Fem::FemMeshObjectPython`` with proxy type
 ``Fem::FemMeshBspTet``, made the way FreeCAD 0.20.2 makes its Gmsh and Netgen mesh objects.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Meshing with the BspTet mesher object, and what scripts call (``import FemBspTet``):
 
     obj = FemBspTet.make_mesher(doc, part, CharacteristicLengthMax=500)

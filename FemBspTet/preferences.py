@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """User preferences of the BspTet mesher (Edit > Preferences > FEM > BspTet).
 
 Stored by FreeCAD under ``User parameter:BaseApp/Preferences/Mod/Fem/BspTet`` (the page

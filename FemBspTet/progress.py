@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """A progress bar on stderr that appears only for runs longer than a second.
 
 ``Progress(enabled=True)`` is called with ``(stage, fraction)``; it draws nothing during the first

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Runs a meshing job in a child process that can always be stopped within a fraction of a second.
 
     from FemBspTet.supervisor import Limits, run_supervised

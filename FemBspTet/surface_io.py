@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Reading and writing triangle surfaces: OFF, STL (ASCII and binary), OBJ, PLY.
 
 Pure Python + numpy; no FreeCAD. Conventions (see :mod:`FemBspTet.mesh_types`):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Task panel of the BspTet mesher object: parameters, Apply/OK/Cancel, progress, Stop, the stats
 and the TetGen comparison table.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """View provider of the BspTet mesher object (on FreeCAD's ``FemGui::ViewProviderFemMeshPython``).
 
 Double click or Edit opens the task panel (:mod:`FemBspTet.task_panel`). Saved files store

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Reading and writing tetrahedral meshes: VTU, Gmsh MSH, Abaqus/CalculiX INP, TetGen, Medit.
 
 Pure Python + numpy (+ the standard library's XML, base64, zlib, lzma); no FreeCAD, no meshio.

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CalculiX on every CAD part: each part meshed by the FEM path in tet10 at h = bounding-box
 diagonal / D, then one linear static solve per part (per group of connected solids, its first
 CAD face fixed and its last one loaded: FemBspTet/fem/calculix_load_case.py), with no FreeCAD.

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Benchmark (not a test): our core beside `tetgen -pY` on the same surfaces.
 
     bench/core_vs_tetgen.py [MODELS_OR_FOLDERS ...] [--timeout S] [--repeats N] [--markdown FILE]

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Our mesher against FreeCAD's Gmsh mesher and Netgen on CAD parts: tets, quality, validity,
 distance to the CAD, whole-process time and peak memory. Usage:
 

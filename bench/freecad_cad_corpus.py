@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Every CAD file of a folder through the FreeCAD mesher pipeline (the FEM path), each in a worker
 process with a time limit: either a mesh (nodes, tets, seconds) or the message the user would see.
 Usage:

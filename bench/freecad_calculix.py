@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The CalculiX acceptance cases of the FreeCAD mesher, with figures: each case solved with our
 mesh and with FreeCAD's Gmsh mesh at the same CharacteristicLengthMax, tet4 and tet10, and the
 ratio of the maximum displacements. Usage: bench/freecad_calculix.py [CASE ...]

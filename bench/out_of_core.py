@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Benchmark (not a test): the out-of-core mode beside the in-memory core and
 `tetgen -pY` on the same surfaces: wall time and peak memory of each run, in the same process tree.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Benchmark (not a test) of the quality stage: our mesher at size h beside TetGen's quality mesh.
 
     bench/refine_vs_tetgen.py [MODELS_OR_FOLDERS ...] [--divisions 20] [--modes exact,rounded]

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Benchmark (not a test): how our core's time and peak memory grow with the input size, beside
 `tetgen -pY` and `tetgen -pq1.414` on the same surfaces.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The main job: meshes the sample CAD part shipped in resources/samples, writes an FEM mesh as
 # .inp and .vtu into out/, prints the statistics and the comparison with TetGen.
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Fuzzes the readers and the core, time-boxed. One target at a time, one process each.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET ...]

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Time-boxed random-mutation fuzzing of the Python readers.
 
     scripts/fuzz_python_readers.py [--seconds 60] [--seed 1] [--findings DIR]

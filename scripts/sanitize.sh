@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The C++ suite under AddressSanitizer + UndefinedBehaviorSanitizer, in its own build
 # directory (build-sanitize/; the Python extension is not built there, so the one in the source
 # tree stays uninstrumented). Runs the whole C++ suite: the unit tests (label `unit`: GoogleTest,

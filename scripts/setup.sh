@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Installs what is missing (Debian 12 packages only) and builds what is stale. Idempotent: a second
 # run installs nothing and rebuilds only changed sources. Needs root or sudo for the install step.
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Runs every test: sets up first (installs what is missing, builds what is stale), then the C++
 # suite through CTest (labels `unit` and `corpus`), then the Python suite through pytest.
 set -uo pipefail

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Closed triangle surfaces of analytic solids, with their exact surface and a projection hook,
 for the quality-stage tests (no data files: generated, deterministic)."""
 

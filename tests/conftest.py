@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Shared pytest set-up: the checkout on sys.path, test data locations, TetGen meshes."""
 
 import os

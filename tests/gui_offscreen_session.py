@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Runs INSIDE FreeCAD's GUI (offscreen):
 #     QT_QPA_PLATFORM=offscreen freecad gui_offscreen_session.py
 # Driven by tests/test_gui_offscreen.py, which gives it a throw-away HOME with the checkout

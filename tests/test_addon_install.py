@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The checkout as a FreeCAD addon: package.xml passes FreeCAD's own metadata reader, and FreeCAD
 loads the addon from ~/.local/share/FreeCAD/Mod/FemBspTet (a symlink to the checkout, as the
 README says) and runs its App tests (``freecadcmd -t TestFemBspTetApp``) in a throw-away HOME.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Bad input and faults, through the command line as a user runs it.
 
 The table below holds one bad input per row: how to make it, the exit code, the words of the

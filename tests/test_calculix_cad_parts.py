@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CalculiX's own verdict on our tet10 meshes of CAD parts, with no FreeCAD: each part of
 tests/data/cad meshed by the FEM path at its automatic size, one CAD face fixed and another
 loaded per group of connected solids (FemBspTet.fem.calculix_load_case), solved by ccx. CalculiX

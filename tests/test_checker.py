@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The mesh checker accepts TetGen's meshes and rejects damaged ones (dropped, flipped,
 duplicated tets, points moved off the surface, inward shells)."""
 

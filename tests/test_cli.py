@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The `fembsptet` command line, run as a user runs it: through bin/fembsptet."""
 
 import json

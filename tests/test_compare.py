@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """`fembsptet compare` and `benchmark`: the table's counts are those of the meshes each mesher
 wrote, recomputed here from the files (not literals), by code independent of the package's."""
 

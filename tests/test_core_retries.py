@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Inputs on which the core's first attempt gets stuck, and the retries that mesh them.
 
 ``tetrahedralize`` (cpp_module/src/mesher.cpp) retries when its Steiner removal cannot move a

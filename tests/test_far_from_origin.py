@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Coordinates at any sane scale: models translated far from the origin, alone and with
 rotations and scales, mesh as well as the original. Scales 1e-6..1e6 with moderate translations
 are in test_mesher_properties.py; here the translation dominates the coordinates (up to 1e8 times

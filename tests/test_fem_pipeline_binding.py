@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The C++ FEM pipeline from CAD through the binding (_bsptet.mesh_cad_file / mesh_cad_brep):
 arrays of the documented shapes, every tet positive and checked exactly, every CAD face and solid
 present, and (with FreeCAD) every node of a face's triangles found by FemMesh.getNodesByFace on a

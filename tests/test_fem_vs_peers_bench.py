@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """bench/fem_vs_peers.py: its measuring code on hand-made tets with known answers, its process
 measurement, and one short run of the whole benchmark on the bracket."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Tests of FemBspTet.freecad_export (TetMesh <-> Fem.FemMesh, mesh files through FreeCAD).
 
 Run with Debian's interpreter from the checkout: ``/usr/bin/python3 -m pytest -q tests``.

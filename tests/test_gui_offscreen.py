@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Offscreen GUI test: FreeCAD's real GUI (``QT_QPA_PLATFORM=offscreen freecad ...``) with the
 checkout installed as a Mod in a throw-away HOME (so the user's configuration is never touched).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The FreeCAD mesher object, headless: creation, properties, meshing through the FEM path (in
 process and in the worker process), SMESH conventions, every boundary node found by
 getNodesByFace (tet4 and tet10 with mid-nodes on curved faces), node groups per CAD face, tet10

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Property tests of the mesher: transformed, scaled and perturbed paper models and corpus models
 (real CAD tessellations), random star-shaped polyhedra and twisted prisms. Each output is checked exactly against its input surface (valid, no
 Steiner point on the surface). Seeds are fixed and printed, so a failure can be replayed."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The out-of-core mode: a solid meshed in pieces small enough for a memory budget,
 from Python and from the command line. Every mesh is read back and checked exactly against the
 input surface (the checker knows nothing of the pieces)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The quality stage: size control, optimization, tet10, the projection hook.
 
 Every mesh is checked exactly here again (core.check_mesh), independently of the check inside

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Repository hygiene: the tracked files speak of the product as it is, and carry a licence line.
 
 * No development history in the text: no "session <n>", no "issue <n>" / "issue #<n>" (history

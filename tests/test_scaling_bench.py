@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The generators and the exponent fit of bench/scaling.py (the scaling benchmark).
 
 Small sizes only; no mesher runs here (speed and memory are measured by the benchmark itself).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Tests of FemBspTet.surface_io (OFF, STL, OBJ, PLY) and FemBspTet.atomic_file.
 
 All data are made here; nothing is read from outside the test's tmp_path.

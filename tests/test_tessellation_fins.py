@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Fins of a CAD tessellation (FemBspTet.cad_tessellation.flip_out_fins): a near-collinear triangle
 along a CAD edge is flipped away inside its face, nothing else changes, and the flat tet it forced
 goes with it.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Validity certificate of 10-node tets through Python (core.certify_tet10, tet10.h): hand-made
 elements, a curved mesh from the quality stage, and the shape checks of the binding."""
 

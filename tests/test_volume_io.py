@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Tests of FemBspTet.volume_io (VTU, MSH, INP, TetGen, Medit).
 
 Meshes are built here: a box split into 6 positively oriented Kuhn tets, and its tet10 version

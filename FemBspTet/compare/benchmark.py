@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The comparison over a folder of models, as a markdown report (``fembsptet benchmark``).
 
     entries = run_benchmark(model_paths(["tests/data/corpus"]), timeout=300)

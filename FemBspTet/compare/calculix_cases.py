@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CalculiX acceptance cases of the FreeCAD mesher, headless: the same analysis solved
 with our mesh and with FreeCAD's Gmsh mesh at the same size.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Our mesher, TetGen and Gmsh on the same surface, each mesh evaluated by the same code.
 
     from FemBspTet.compare.comparison import compare, format_table

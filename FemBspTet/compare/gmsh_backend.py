@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Gmsh's 3D mesher as a separate program (GPL: never linked or imported), on the surface we mesh.
 
 ``run_gmsh(surface, size)`` writes the surface as a Gmsh MSH 2.2 file (one discrete surface,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Our mesher in a process of its own, so that the comparison measures it as it measures TetGen and
 Gmsh (wall time and peak memory of one process, :func:`.process.run_measured`).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """One external program, measured alone: wall time, peak resident memory, output, exit code.
 
     run = run_measured(["tetgen", "-pYQ", "surface.off"], timeout=600, cwd=workdir)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """TetGen as a separate program (AGPL: never linked), on exactly the surface we mesh.
 
 ``run_tetgen(surface, switches)`` writes the surface as OFF with round-trip precision, runs

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """A linear static CalculiX analysis of a CAD FEM mesh, with no FreeCAD: the solver's own verdict
 on the elements (it refuses a tet10 whose Jacobian is not positive at its integration points).
 

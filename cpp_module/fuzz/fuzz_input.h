@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet fuzz targets: shared helpers. Each target defines LLVMFuzzerTestOneInput; it is built
 // twice: with libFuzzer (-DFEMBSPTET_FUZZ=ON, scripts/fuzz.sh) and, linked with replay_main.cpp, as
 // a plain program that replays the pinned findings in regressions/<target>/ (a CTest, label unit).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzz target: the C++ OFF reader (mesh_io.h parse_off) on arbitrary bytes. Only InputError may
 // come out; what it returns must have indices in range and finite coordinates.
 #include <cmath>

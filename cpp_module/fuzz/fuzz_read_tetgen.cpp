@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzz target: the C++ TetGen reader (mesh_io.h parse_tetgen). The input is the .node text, a NUL
 // byte, then the .ele text. Only InputError may come out; a returned mesh has indices in range.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzz target: the input surface check (surface_check.h) on small arbitrary triangle soups: up to
 // 12 points on a small grid (ties, collinear and coplanar points on purpose) and up to 24
 // triangles with indices that may be out of range. Only InputError may come out. When the check

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzz target: the whole core on small closed surfaces. The first byte picks a closed
 // triangulation (tetrahedron, octahedron, triangular prism, cube, hexagonal bipyramid); the
 // following bytes place its vertices on a small grid (coplanar faces, collinear edges, ties) or

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Replays fuzz inputs without libFuzzer: every file named on the command line, or every file in a
 // directory named there (sorted, so runs are deterministic). Exits 0 when none crashed.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the out-of-core mode, a solid meshed in pieces (out_of_core.h).
 #include "bsptet/out_of_core.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 #include "bsptet/self_intersection.h"
 
 #include <algorithm>

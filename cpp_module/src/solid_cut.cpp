@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: cutting a solid in two along caps of its own vertices and new points (solid_cut.h).
 #include "bsptet/solid_cut.h"
 

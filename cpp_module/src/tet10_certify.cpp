@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Validity certificate of 10-node tets: Bezier coefficients of det J, enclosed in intervals, with
 // adaptive subdivision (tet10.h states the method and the derivation of the coefficients).
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Wall thickness (see wall_thickness.h).
 #include "bsptet/wall_thickness.h"
 

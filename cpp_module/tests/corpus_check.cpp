@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Corpus driver (CTest label `corpus`): runs `tetgen -pYQ` on one corpus surface, reads the mesh
 // back and runs the exact checker, which must agree with the expectation given on the command
 // line ("valid" or "invalid"). TetGen is run as a separate program (it is AGPL: never linked).

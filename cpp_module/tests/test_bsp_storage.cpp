@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The BSP complex's compact storage: the flat edge maps (edge_map.h) against std::unordered_map
 // on random operations, the face lists' spill to the heap, and the float face boxes' enclosure.
 #include <gtest/gtest.h>

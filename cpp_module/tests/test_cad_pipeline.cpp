@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The FEM pipeline from CAD (fem/fem_mesh.h) and the CAD projection hook (cad/cad_projection.h).
 // Every mesh is held to invariants: checked exactly (positive tets, conforming faces, closed
 // boundary, consistent mid-nodes), every 10-node tet certified valid, the boundary equal to the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The CAD surface mesher (cad/cad_surface.h) on real parts and on shapes built here: each solid's
 // surface is closed and oriented outward, every CAD face is meshed, no triangle is folded, the
 // triangles are shaped and sized as asked, and every node lies on the CAD entity it names.

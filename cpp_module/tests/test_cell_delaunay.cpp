@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The per-cell Delaunay (cell_delaunay.h): sign conventions of the lifted predicates, then
 // Bowyer-Watson on cospherical and grid point sets (ties everywhere), checked for positive tets,
 // a boundary equal to the convex hull's face triangulations computed separately per face, and

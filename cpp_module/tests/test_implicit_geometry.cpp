@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A TPI vertex must behave exactly like the explicit point at the same place. Three axis-aligned
 // planes through grid points meet at a grid point; oblique planes through grid points then pass
 // exactly through many of them (exact zeros), which exercises the filter and the exact fallback.

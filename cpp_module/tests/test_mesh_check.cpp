@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The checker accepts a valid Kuhn subdivision of a box and rejects every kind of damage.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The tetrahedralizer on the paper's polyhedra and on small generated solids: every output is
 // checked by the exact checker.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The out-of-core mode (out_of_core.h) and its cuts (solid_cut.h): the two pieces of a cut bound
 // the input's solid between them exactly, and the pieces' meshes, streamed into one file, make a
 // mesh of the input that the exact checker accepts.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Differential tests of the filtered predicates against the exact ones, on random, near-degenerate
 // (one ulp, 2^-45 perturbations) and extreme-scale inputs. Seeds are printed and fixed.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The quality stage: RefineMesh's local operations on hand-made meshes (each checked exactly, each
 // refused when invalid) and the driver on real data (tet10 validity: test_tet10_certify.cpp).
 #include <gtest/gtest.h>

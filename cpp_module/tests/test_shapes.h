@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Small closed surfaces built in the tests (shared by several test files).
 #pragma once
 

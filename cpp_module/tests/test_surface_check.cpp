@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The input surface check (surface_check.h) and its exact intersection tests: each defect is found,
 // named (code, element index, words of the message), and the repairs of --reorient are right.
 #include <gtest/gtest.h>

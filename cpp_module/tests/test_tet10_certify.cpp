@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Validity of 10-node tets (tet10.h): the Bezier coefficients of det J against a direct
 // evaluation from the C3D10 shape functions, straight tets, invalid and strongly curved elements,
 // soundness under rounding (exact rational arithmetic), and make_second_order through the driver.

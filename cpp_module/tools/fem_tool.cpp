@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // bsptet_fem: a CAD file to a tetrahedral FEM mesh (fem/fem_mesh.h), with its figures.
 //
 //   bsptet_fem PART.step [--size H] [--order 1|2] [--vtu OUT.vtu] [--off OUT.off] [--distance]

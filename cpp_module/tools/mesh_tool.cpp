@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // bsptet_mesh: the core from the command line, for debugging and benchmarks (users run `fembsptet`).
 // Meshes one OFF surface, checks the result exactly and prints one line of figures.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // bsptet_refine: the core then the quality stage, from the command line (debugging, benchmarks;
 // users run `fembsptet mesh --size H`). Meshes one OFF surface, refines it, checks the result
 // exactly and prints one line of figures.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the BSP as a conforming convex cell complex (paper Sec. 2.1-2.2: BSP tree and
 // convex decomposition; Sec. 2.2.1: BSP points).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: inside/outside of the leaf cells (paper Sec. 2.2: "convex subpolyhedra in the
 // polyhedron"). A leaf face on an input plane is either wholly covered by coplanar input triangles
 // or not at all (no input triangle crosses a leaf). Its coverage (+1 when the covering triangles'

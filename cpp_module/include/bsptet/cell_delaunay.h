@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the paper's per-cell Delaunay tetrahedralization (Sec. 2.3), exact, and the face
 // triangulations that make the cells' tets conform.
 //

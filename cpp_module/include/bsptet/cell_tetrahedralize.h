@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: tets from the convex leaf cells (paper Sec. 2.3), identical on both sides of
 // every face.
 //

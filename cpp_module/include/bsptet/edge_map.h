@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Flat hash maps keyed by an edge (two vertex ids packed into 64 bits), for the BSP complex's edge
 // records: one array of slots (open addressing, linear probing, deletion by backward shift), so an
 // entry costs no allocation of its own. std::unordered_map spent a node (48 bytes) and a bucket

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: typed errors. The core never prints and never exits; it throws these.
 // The Python binding maps InputError -> ValueError (bad input, CLI exit 2) and
 // MeshingError -> RuntimeError (internal failure, CLI exit 1).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: an exact binary floating-point number, value = mantissa * 2^exponent with an
 // arbitrary-precision integer mantissa (GMP). Every double converts exactly; +, -, * are exact.
 // Used as the exact fallback of the filtered predicates and for exact area/volume sums. There is no

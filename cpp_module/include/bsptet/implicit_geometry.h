@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the exact geometry of the BSP. Every point the BSP creates stays implicit: it is
 // either an EXPLICIT point (an input vertex or a bounding-box corner, double coordinates) or the
 // intersection of three planes (TPI). Every plane passes through three explicit points, so all

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: interval arithmetic used as the floating-point filter of the indirect predicates.
 // Every operation rounds to nearest and then widens the result by one ulp on each side, which
 // encloses the exact result of the operation on any values inside the operand intervals (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the mesh checker. Decides, exactly on the output doubles, whether a tet mesh is a
 // valid constrained tetrahedralization of a closed input surface. Used by the tests on every mesh
 // they make, by the mesher itself (`valid` in the stats) and by `fembsptet check`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: minimal file I/O for C++ tests, fuzz targets and debug dumps. The user-facing
 // readers and writers (every format, precise messages) are in the Python package; these follow the
 // same conventions (types.h) and throw InputError naming the file and line.

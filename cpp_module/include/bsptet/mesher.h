@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the single entry point of the tetrahedralizer.
 //
 //   TetMesh tetrahedralize(const SurfaceMesh& surface, const MeshOptions& options, MeshStats* stats)

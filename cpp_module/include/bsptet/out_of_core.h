@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the out-of-core mode. The paper (Sec. 4.3) swaps completed cells to disk; this
 // core's peak is in its Delaunay seed, before any cell is complete (docs/design/out-of-core.md),
 // so instead the SOLID is cut into pieces small enough for the memory, each piece is meshed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the Delaunay tetrahedralization of explicit (double) points, the first step of
 // the BSP's Delaunay seed (bsp_seed.cpp).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the geometric predicates on double coordinates. The only sign authority for
 // double inputs: a floating-point filter with a proven error bound decides when it can; otherwise
 // the sign is computed exactly (orient3d: floating-point expansions, ExactFloat outside their safe

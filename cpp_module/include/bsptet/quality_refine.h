@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet quality stage: from the core's covering mesh to an FEM mesh of a given element size,
 // with better-shaped tets and, on request, 10-node tets.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet quality stage: an editable tetrahedral mesh of a closed input surface, changed only by
 // local operations (edge split, edge collapse, 2-3 and 3-2 flips, edge removal, point relocation,
 // point insertion) that are each

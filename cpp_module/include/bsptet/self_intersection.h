@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the self-intersections of a triangle surface, exactly.
 //
 //   pairs = find_self_intersections(surface, max_pairs, &complete)

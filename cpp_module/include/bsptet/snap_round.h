@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: back to doubles. Implicit vertices are rounded to the nearest doubles; input
 // vertices are never rounded. Every tet is then re-checked exactly on the doubles; rounding that
 // inverts or flattens a tet, or merges two points, is reported (local repair is not built yet).

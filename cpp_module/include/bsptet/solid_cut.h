@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: cutting a solid in two along caps of its own vertices and points of their own, for the
 // out-of-core mode (out_of_core.h), which meshes the pieces one after the other.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: SplitMix64, the small deterministic generator behind every randomized order
 // of the core (insertion orders, walk directions). The state is the caller's: no global state,
 // the same seed gives the same sequence on every machine.

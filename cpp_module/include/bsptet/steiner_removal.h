@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: fewer Steiner points, none on the surface, and every point a double (beyond the
 // paper: its Sec. 4.2 counts the BSP points but keeps them all).
 //

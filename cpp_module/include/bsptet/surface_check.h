@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: the input surface check, before any meshing. Decides exactly whether a triangle
 // surface bounds a solid the mesher can fill, and names the first problem precisely.
 //

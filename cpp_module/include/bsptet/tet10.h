@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet quality stage: second-order (10-node) tets from a linear RefineMesh, and the
 // certificate of their validity.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet quality stage: shape measures of one tetrahedron, in double precision. They only rank
 // candidate meshes (which flip, which position is better); they never decide validity, which is
 // the exact orient3d of predicates.h.

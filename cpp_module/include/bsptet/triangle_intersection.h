@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: exact intersection tests between closed segments and closed triangles whose
 // corners are doubles. Every decision is a sign of orient3d / orient2d_projected (predicates.h), so
 // the answers are exact for every finite input; there is no tolerance anywhere.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: flat mesh containers.
 //
 // Conventions, stated once for the whole core:

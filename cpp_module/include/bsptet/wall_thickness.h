@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet quality stage, sizing: the local thickness of a solid's wall at a point of its surface.
 //
 //   WallThickness walls(surface);

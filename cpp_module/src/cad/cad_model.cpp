@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: reading CAD files and numbering their topology (see cad_model.h).
 #include "bsptet/cad/cad_model.h"
 

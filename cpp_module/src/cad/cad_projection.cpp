@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: projection onto CAD faces and edges (see cad_projection.h).
 #include "bsptet/cad/cad_projection.h"
 

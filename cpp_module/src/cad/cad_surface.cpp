@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: edges, then faces, then each solid's surface (see cad_surface.h).
 #include "bsptet/cad/cad_surface.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: edge discretization (see edge_mesher.h).
 #include "bsptet/cad/edge_mesher.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: the size field (see size_field.h).
 #include "bsptet/cad/size_field.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: polygon triangulation in the parameter plane (see uv_polygon.h).
 #include "bsptet/cad/uv_polygon.h"
 

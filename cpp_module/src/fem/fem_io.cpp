@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet FEM pipeline: VTU output (see fem_io.h).
 #include "bsptet/fem/fem_io.h"
 

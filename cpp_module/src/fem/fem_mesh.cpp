@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet FEM pipeline: CAD surface, core, refinement and merge of the solids (see fem_mesh.h).
 #include "bsptet/fem/fem_mesh.h"
 

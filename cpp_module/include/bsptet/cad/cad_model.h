@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: a CAD shape read through OpenCASCADE, with its topology numbered.
 //
 //   CadModel read_cad_file(const std::string& path)       // .step .stp .brep .brp .iges .igs

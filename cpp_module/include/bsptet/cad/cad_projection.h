@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: points put onto the CAD faces and edges of a model, the projection hook of
 // the quality stage (refine_mesh.h ProjectionHook) backed by OpenCASCADE.
 //

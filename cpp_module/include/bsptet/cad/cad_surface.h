@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: the boundary of every solid of a CAD model, meshed at the size field.
 //
 //   CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& options,

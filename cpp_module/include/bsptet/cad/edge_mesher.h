@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: nodes along a CAD edge at the size field.
 //
 //   EdgeSizing sample_edge_sizing(edge, base_size, field)

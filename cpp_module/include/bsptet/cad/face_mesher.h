@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: triangles of one CAD face at the size field, its boundary nodes fixed.
 //
 //   FaceMesh mesh_face(forward_face, loops, options, first_new_node)

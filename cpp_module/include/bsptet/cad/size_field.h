@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: the element size field on a CAD model.
 //
 // The size h at a point is the smallest of:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: triangulating a face's boundary polygon in its parameter plane.
 //
 //   std::vector<std::array<int, 3>> triangulate_polygon(uv, loops)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet FEM pipeline: writing a FemMesh for viewers (ParaView) and debugging. The user-facing
 // writers (CalculiX .inp, FreeCAD FemMesh) are in the Python package.
 #pragma once

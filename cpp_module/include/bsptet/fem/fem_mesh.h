@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet FEM pipeline: a CAD model to a tetrahedral FEM mesh, one entry point.
 //
 //   FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats)
