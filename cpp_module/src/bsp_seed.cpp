@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet core: seeding the BSP complex with a Delaunay tetrahedralization of the input points
 // (the idea of Diazzi & Attene's BSP complex, 2021), see bsp_complex.h.
 //
