@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: face meshing by local operations in the parameter plane (see face_mesher.h).
 #include "bsptet/cad/face_mesher.h"
 
@@ -20,6 +21,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kSplitRatio = 1.4;     // split edges longer than this times the size
 constexpr double kCollapseRatio = 0.7;  // collapse edges shorter than this times the size
+constexpr double kSmoothKeep = 0.7;     // smoothing for the mean never takes a triangle below this
 
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 Vec3 cross(const Vec3& a, const Vec3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
@@ -318,12 +320,14 @@ bool FaceMesher::smooth(int v) {
   if (verts_[v].boundary) return false;
   const auto& ring = vt_[static_cast<std::size_t>(v)];
   if (ring.empty()) return false;
-  double before = kInf;
+  double before = kInf, mean_before = 0;
   Uv target{0, 0};
   int count = 0;
   for (int t : ring) {
     const Tri& x = tris_[static_cast<std::size_t>(t)];
-    before = std::min(before, quality(x[0], x[1], x[2]));
+    const double q = quality(x[0], x[1], x[2]);
+    before = std::min(before, q);
+    mean_before += q / static_cast<double>(ring.size());
     for (int u : x) {
       if (u == v) continue;
       target[0] += verts_[u].uv[0];
@@ -337,7 +341,7 @@ bool FaceMesher::smooth(int v) {
     verts_[v].uv = {saved.uv[0] + w * (target[0] - saved.uv[0]), saved.uv[1] + w * (target[1] - saved.uv[1])};
     verts_[v].xyz = eval(verts_[v].uv);
     verts_[v].normal = normal(verts_[v].uv);
-    double after = kInf;
+    double after = kInf, mean_after = 0;
     bool ok = true;
     for (int t : ring) {
       const Tri& x = tris_[static_cast<std::size_t>(t)];
@@ -345,9 +349,15 @@ bool FaceMesher::smooth(int v) {
         ok = false;
         break;
       }
-      after = std::min(after, quality(x[0], x[1], x[2]));
+      const double q = quality(x[0], x[1], x[2]);
+      after = std::min(after, q);
+      mean_after += q / static_cast<double>(ring.size());
     }
-    if (ok && after > before + 1e-9) {
+    // Applied when the worst triangle around gets better, or when the mean does and the worst
+    // stays at least min(the worst before, kSmoothKeep): the typical triangle gets better too,
+    // not only the worst of each ring.
+    const double keep = std::min(before, kSmoothKeep);
+    if (ok && (after > before + 1e-9 || (after >= keep && mean_after > mean_before + 1e-9))) {
       verts_[v].size = size_at(verts_[v].uv, verts_[v].xyz);
       return true;
     }
