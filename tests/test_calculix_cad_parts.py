@@ -35,5 +35,8 @@ def test_calculix_solves_a_face_load_on_our_tet10_mesh(part, tmp_path):
         assert np.linalg.norm(disp[_face_nodes(result, face - 1)], axis=1).max() > 0
     for face in figures["fixed_faces"]:
         assert np.abs(disp[_face_nodes(result, face - 1)]).max() == 0.0
+    with open(os.path.join(tmp_path, "job.inp")) as deck:  # CalculiX reads 20-character fields
+        assert all(len(field.strip()) <= 20 for line in deck if not line.startswith("*")
+                   for field in line.split(","))
     log = open(os.path.join(tmp_path, "ccx.log")).read()
     assert "nonpositive jacobian" not in log.lower() and "*ERROR" not in log

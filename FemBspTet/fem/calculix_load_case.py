@@ -144,7 +144,7 @@ def solve_face_load(result, workdir, ccx=None, timeout=1800):
     if faces_of_solid_nodes:
         lines.append("*CLOAD\n")
         for k, f in faces_of_solid_nodes:
-            lines += [f"LOAD{k}, {d + 1}, {f[d]!r}\n" for d in range(3)]
+            lines += [f"LOAD{k}, {d + 1}, {f[d]:.12e}\n" for d in range(3)]  # a 20-character field
     if gravity:
         lines.append("*DLOAD\n")
         lines += [f"BODY{k}, GRAV, 9810., 0., 0., -1.\n" for k in gravity]
