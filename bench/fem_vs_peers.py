@@ -29,6 +29,7 @@ import datetime
 import json
 import os
 import platform
+import re
 import shlex
 import shutil
 import signal
@@ -85,6 +86,12 @@ class Run:
     def __init__(self, ok, seconds, cpu_seconds, peak_bytes, returncode, message):
         self.ok, self.seconds, self.cpu_seconds = ok, seconds, cpu_seconds
         self.peak_bytes, self.returncode, self.message = peak_bytes, returncode, message
+
+
+def portable(message):
+    """A message without the folders of absolute paths (the part's folder, temporary folders):
+    the report names files, not the machine it ran on."""
+    return re.sub(r"(?<![\w.])(?:/[^\s/:'\"]+)+/(?=[^\s/])", "", message)
 
 
 def session_rss_bytes(sid):
@@ -628,7 +635,7 @@ def fmt(value, spec):
 
 def row_cells(row):
     if not row["ok"]:
-        return [row["mesher"], "failed: " + row["message"][:160], "", "",
+        return [row["mesher"], "failed: " + portable(row["message"])[:160], "", "",
                 fmt(row["seconds"], ".1f"), fmt(row["cpu_seconds"], ".1f"),
                 fmt(row["peak_mb"], ".0f")] + [""] * 7
     return [row["mesher"], "ok", str(row["tets"]), str(row["nodes"]), fmt(row["seconds"], ".1f"),
@@ -1007,7 +1014,7 @@ def plot_bracket(results, args, path):
                       rotation)
         else:
             ax.set_axis_off()
-            ax.text(0.5, 0.5, "%s failed:\n%s" % (m, row["message"][:80]), ha="center",
+            ax.text(0.5, 0.5, "%s failed:\n%s" % (m, portable(row["message"])[:80]), ha="center",
                     va="center", wrap=True, transform=ax.transAxes)
     fig.suptitle("bracket.step, h = diagonal / 20 = %.3g, order %d (boundary faces; curved "
                  "edges through their mid-nodes)" % (case["h"], args.order))
