@@ -23,8 +23,12 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 CORPUS = os.path.join(os.path.dirname(ROOT), "shared", "data", "corpus", "cad")
 BRACKET = os.path.join(ROOT, "resources", "samples", "bracket.step")
+
+
+from fem_vs_peers import portable  # noqa: E402  (messages without machine paths)
 
 
 def worker(part, divisions, workdir, out):
@@ -57,7 +61,7 @@ def run_one(part, divisions, timeout):
     seconds = time.perf_counter() - t0
     if run.returncode != 0:
         lines = [ln for ln in run.stderr.splitlines() if ln.strip()]
-        return {"verdict": "failed: " + (lines[-1] if lines else f"exit {run.returncode}")[:200],
+        return {"verdict": "failed: " + portable(lines[-1] if lines else f"exit {run.returncode}")[:200],
                 "seconds": seconds}
     with open(out) as f:
         figures = json.load(f)
