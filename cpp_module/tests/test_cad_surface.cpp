@@ -143,22 +143,32 @@ TEST(CadSurface, BracketHolesAndFilletAreUniform) {
 }
 
 TEST(CadSurface, ThreadStripWindingAroundItsAxisMeshesWithoutCrossings) {
-  // The OCCT tutorial bottle: its thread's lower flank (Face4) is a B-spline strip 0.4 mm wide
-  // that winds twice around the neck while u runs over [0, pi], so nodes close in (u, v) are a
-  // whole turn apart on the surface; an ear-cut start judged by its 3D chords folded through the
-  // neck. The surface must come out free of crossing triangles.
+  // The OCCT tutorial bottle: its thread's flanks are B-spline strips 0.4 mm wide that wind twice
+  // around the neck (Face4 while u runs over [0, pi], Face2 over [0, 4 pi]), so nodes close in
+  // (u, v) are up to a whole turn apart on the surface. Ear cutting fans one boundary node out to
+  // hundreds across the strip: needles a turn long, folded through the neck in places and thin
+  // but facing the surface's way elsewhere. Whether the later rounds happened to untangle what
+  // was left depended on the size (4.697 meshed, FreeCAD's diagonal / 20 = 4.697073557013984 did
+  // not), so the surface must come out free of crossing triangles at several sizes, that one
+  // included (0: the automatic size).
   const cad::CadModel model = cad::read_cad_file(data("cad/bottle.brep"));
-  cad::CadSurfaceStats stats;
-  const cad::CadSurface s = cad::mesh_cad_surface(model, {}, &stats);
-  ASSERT_EQ(s.solid_tri.size(), 1u);
-  bool complete = true;
-  const auto pairs = find_self_intersections(s.solid_surface(0), 10, &complete);
-  EXPECT_TRUE(pairs.empty()) << pairs.size() << " crossing pairs, the first triangles " << pairs[0][0] << " and "
-                             << pairs[0][1];
-  // The strip's end creases (its normal turns by more than 90 degrees within 1% of its u
-  // range): the few triangles there that oppose one corner's normal are the only folds.
-  for (const auto& [face, folds] : stats.folded_faces) EXPECT_EQ(face, 3) << "Face" << face + 1 << ": " << folds;
-  EXPECT_LT(stats.folds, stats.triangles / 1000);
+  for (const double size : {0.0, 4.697073557013984, 4.697, 3.0, 4.5, 5.0, 6.0, model.diagonal() / 12}) {
+    SCOPED_TRACE("size " + std::to_string(size));
+    cad::CadSurfaceOptions options;
+    options.size.size = size;
+    cad::CadSurfaceStats stats;
+    const cad::CadSurface s = cad::mesh_cad_surface(model, options, &stats);
+    ASSERT_EQ(s.solid_tri.size(), 1u);
+    bool complete = true;
+    const auto pairs = find_self_intersections(s.solid_surface(0), 10, &complete);
+    EXPECT_TRUE(pairs.empty()) << pairs.size() << " crossing pairs, the first triangles " << pairs[0][0] << " and "
+                               << pairs[0][1] << ", of Face" << s.solid_tag[0][static_cast<std::size_t>(pairs[0][0])] + 1
+                               << " and Face" << s.solid_tag[0][static_cast<std::size_t>(pairs[0][1])] + 1;
+    // Face4's end creases (its normal turns by more than 90 degrees within 1% of its u range):
+    // the few triangles there that oppose one corner's normal are the only folds.
+    for (const auto& [face, folds] : stats.folded_faces) EXPECT_EQ(face, 3) << "Face" << face + 1 << ": " << folds;
+    EXPECT_LT(stats.folds, stats.triangles / 1000);
+  }
 }
 
 TEST(CadSurface, TwoSolidsWithSeams) {

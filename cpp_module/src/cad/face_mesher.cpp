@@ -425,16 +425,26 @@ int FaceMesher::flip_pass() {
   return total;
 }
 
-/// The start triangulation's folded triangles flipped in the surface's metric rather than in 3D:
-/// a quad (two triangles on an edge) with a triangle folded in 3D is measured in the first
-/// fundamental form at its (u, v) centroid, and its diagonal is flipped when that raises the
-/// smaller metric shape of its two triangles (Lawson's order, as flip_pass). Ear cutting joins
-/// boundary nodes that are close in (u, v) but may be far apart on the surface (a thread's strip
-/// winds around its axis over a short u interval); such a fan is folded in 3D almost everywhere,
-/// where a flip judged on the 3D chords has nothing better to go to, while in the metric every
-/// flip heads for the triangulation the surface's own lengths ask for. Quads with no fold are
-/// left to flip_pass, and quads with a pole corner too (the metric degenerates there).
+/// The start triangulation flipped in the surface's metric rather than in 3D: each quad (two
+/// triangles on an edge) is measured in the first fundamental form at its (u, v) centroid, and
+/// its diagonal is flipped when that raises the smaller metric shape of its two triangles
+/// (Lawson's order, as flip_pass). Ear cutting joins boundary nodes that are close in (u, v) but
+/// may be far apart on the surface (a thread's strip winds around its axis over a short u
+/// interval): a fan of needles a whole turn long, folded in 3D in places and, elsewhere, thin
+/// chords that face the surface's way and so look valid. A flip judged on the 3D chords has
+/// nothing better to go to there, while in the metric every flip heads for the triangulation
+/// the surface's own lengths ask for; a fan is undone from its ends inwards, across triangles
+/// that are not folded too, so once the start holds a fold every quad is considered, not only
+/// those with one. A start with no fold (the usual case: a face whose (u, v) is proportionate)
+/// is left to flip_pass alone, and quads with a pole corner too (the metric degenerates there).
 int FaceMesher::metric_flip_pass() {
+  bool folded = false;
+  for (std::size_t t = 0; t < tris_.size() && !folded; ++t) {
+    const Tri& x = tris_[t];
+    folded = alive_[t] && !verts_[x[0]].pole && !verts_[x[1]].pole && !verts_[x[2]].pole &&
+             !(quality(x[0], x[1], x[2]) > 0);
+  }
+  if (!folded) return 0;
   std::vector<std::pair<int, int>> stack = interior_edges();
   std::reverse(stack.begin(), stack.end());
   const std::size_t cap = 50 * tris_.size() + 1000;
@@ -448,7 +458,6 @@ int FaceMesher::metric_flip_pass() {
     const int d = opposite(tris_[static_cast<std::size_t>(t1)], a, b);
     if (c == d || seam_pair(c, d)) continue;
     if (verts_[a].pole || verts_[b].pole || verts_[c].pole || verts_[d].pole) continue;
-    if (quality(a, b, c) > 0 && quality(b, a, d) > 0) continue;  // neither folded: left to flip_pass
     if (!valid(a, d, c) || !valid(d, b, c)) continue;
     const Uv &ua = verts_[a].uv, &ub = verts_[b].uv, &uc = verts_[c].uv, &ud = verts_[d].uv;
     const auto m = metric({0.25 * (ua[0] + ub[0] + uc[0] + ud[0]), 0.25 * (ua[1] + ub[1] + uc[1] + ud[1])});
@@ -534,7 +543,7 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
   }
   for (const auto& t : triangulate_polygon(uv, index_loops)) add_tri({t[0], t[1], t[2]});
 
-  metric_flip_pass();  // the ear-cut fan's folds into the surface's own shapes,
+  metric_flip_pass();  // the ear-cut fan into the surface's own shapes,
   flip_pass();         // then into better 3D shapes: splits then spread points evenly
   for (int round = 0; round < options_.max_rounds; ++round) {
     const int splits = split_pass();

@@ -7,10 +7,10 @@
 // Gmsh's MeshAdapt does):
 //  1. the boundary loops (the nodes of the face's edges, at their pcurve parameters) are
 //     triangulated in (u, v) by ear cutting (uv_polygon.h), and that fan is flipped towards
-//     better shapes: where a triangle is folded in 3D, first measured in the surface's metric
-//     (the first fundamental form at each quad's (u, v) centroid: nodes close in (u, v) may be
-//     far apart on the surface, and a fan of such triangles is folded almost everywhere), then
-//     everywhere in 3D;
+//     better shapes: when a triangle is folded in 3D, first everywhere measured in the
+//     surface's metric (the first fundamental form at each quad's (u, v) centroid: nodes close
+//     in (u, v) may be far apart on the surface, and a fan of such triangles is needles a turn
+//     long, folded in places), then in 3D;
 //  2. rounds of local operations, each kept only when every triangle it makes is valid (below):
 //     interior edges longer than 1.4 times the local size are split at their (u, v) midpoint
 //     (the new node evaluated on the surface), edges shorter than 0.7 times it are collapsed onto
