@@ -105,7 +105,31 @@ def write_output(path, mesh, surface=None):
     else:
         from .volume_io import write_tet_mesh
 
+        _check_stored(path, mesh)
         write_tet_mesh(path, mesh, surface)
+
+
+def _check_stored(path, mesh):
+    """A format that rounds coordinates (``.inp``: CalculiX's 20-character fields) must not
+    turn the valid mesh into an invalid one: the mesh as the file will hold it is checked
+    exactly (orientation, flat tets, tet10 mid-nodes) before it is written."""
+    from . import core
+    from .mesh_types import TetMesh
+    from .volume_io import stored_points
+
+    points = stored_points(path, mesh.points)
+    changed = (points != mesh.points).any(axis=1)
+    if not changed.any():
+        return
+    stored = TetMesh(points, mesh.tets, source=mesh.source)
+    report = core.check_mesh(core.boundary_surface(stored), stored, max_messages=3,
+                             compute_quality=False)
+    if not report["valid"]:
+        raise InputError(
+            f"the format's fixed-width fields round {int(changed.sum())} nodes' coordinates, "
+            "and the rounded mesh is not valid (" + "; ".join(report["messages"]) + "); "
+            "write .vtu, .msh or .mesh instead, or move the model away from values that need "
+            "more than 20 characters (tiny non-zero coordinates)", where=path)
 
 
 def read_volume(path):
@@ -350,6 +374,11 @@ def _cmd_check(args):
         )
     surface = read_surface(args.surface)
     mesh = read_volume(args.tetmesh)
+    if _ext(args.tetmesh) in VOLUME_EXTENSIONS:
+        from .volume_io import stored_points
+
+        # the reference as the mesh's format stores coordinates (.inp rounds some)
+        surface.points = stored_points(args.tetmesh, surface.points)
     report = core.check_mesh(surface, mesh, max_messages=args.max_messages)
     if args.json:
         json.dump(report, sys.stdout, indent=1)

@@ -334,3 +334,25 @@ def test_mesh_refuses_the_former_on_cad_flags(cli, tmp_path):
         r = run(cli, "mesh", cad, "-o", tmp_path / "x.vtu", flag)
         assert r.returncode == 2 and "unrecognized arguments: " + flag in r.stderr
     assert not (tmp_path / "x.vtu").exists()
+
+
+def test_inp_output_refused_when_its_rounding_would_flatten_a_tet(tmp_path):
+    """.inp coordinates are rounded to CalculiX's 20-character fields; the mesh as the file
+    would hold it is checked exactly first. Here d's x and z differ in the 17th digit only:
+    rounded, d lies on the plane z = x through a, b, c and the tet is flat."""
+    import numpy as np
+
+    from FemBspTet import core
+    from FemBspTet.cli import write_output
+    from FemBspTet.errors import InputError
+
+    pts = np.array([[0, 0, 0], [1, 0, 1], [0, 1, 0],
+                    [-0.00012345678901234567, 0.5, -0.00012345678901234564]])
+    tet = [0, 1, 2, 3] if core.orient3d(*pts) > 0 else [1, 0, 2, 3]
+    mesh = TetMesh(pts, np.array([tet]))
+    assert core.check_mesh(core.boundary_surface(mesh), mesh)["valid"]
+    write_output(str(tmp_path / "ok.vtu"), mesh)  # exact formats take it
+    with pytest.raises(InputError) as exc:
+        write_output(str(tmp_path / "bad.inp"), mesh)
+    assert "bad.inp" in str(exc.value) and "20 characters" in str(exc.value)
+    assert not (tmp_path / "bad.inp").exists()

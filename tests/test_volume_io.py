@@ -20,7 +20,8 @@ import pytest
 from FemBspTet import volume_io
 from FemBspTet.errors import InputError, InternalError
 from FemBspTet.mesh_types import Surface, TetMesh
-from FemBspTet.volume_io import read_tet_mesh, read_tetgen, tetgen_paths, write_tet_mesh
+from FemBspTet.volume_io import (read_tet_mesh, read_tetgen, stored_points, tetgen_paths,
+                                 write_tet_mesh)
 
 
 # our mid-edge node 4 + k lies on the edge _EDGES[k] (0-based corners)
@@ -652,6 +653,11 @@ def test_inp_coordinates_fit_calculix_20_character_fields(tmp_path):
     back = np.array([[float(f) for f in row[1:]] for row in rows])
     assert np.allclose(back, pts, rtol=1e-13, atol=0)
     assert back[3, 2] == 123.45678901234567 and back[3, 0] == 0.1  # short ones exact
+    # stored_points is exactly what the file holds (the exact check rounds its reference so)
+    assert np.array_equal(stored_points(tmp_path / "m.inp", pts), back)
+    assert np.array_equal(read_tet_mesh(tmp_path / "m.inp").points, back)
+    assert stored_points(tmp_path / "m.vtu", pts) is not None
+    assert np.array_equal(stored_points(tmp_path / "m.vtu", pts), pts)
 
 
 # ------------------------------------------------------------------------------------------
