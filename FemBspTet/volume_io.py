@@ -896,9 +896,15 @@ def stored_points(path, points):
     points = np.asarray(points, dtype=np.float64)
     if _extension(os.fspath(path)) != ".inp":
         return points
-    flat = points.reshape(-1).tolist()
-    rounded = np.array([float(_inp_number(v)) for v in flat], dtype=np.float64)
-    return rounded.reshape(points.shape)
+    # repr of a value with 0.1 <= |v| < 1e15 has at most 17 digits, a point and a sign: 20
+    # characters at most, written exactly; only the others can be rounded
+    magnitude = np.abs(points)
+    maybe = (magnitude != 0) & ((magnitude < 0.1) | ~(magnitude < 1e15))
+    if not maybe.any():
+        return points
+    rounded = points.copy()
+    rounded[maybe] = [float(_inp_number(v)) for v in points[maybe].tolist()]
+    return rounded
 
 
 def _write_inp(path, points, tets, boundary):
