@@ -96,17 +96,18 @@ def check_output_path(path):
         raise InputError("the output directory does not exist", where=parent)
 
 
-def write_output(path, mesh, surface=None):
+def write_output(path, mesh, groups=None):
+    """Write ``mesh`` (with its named sets ``groups``, a MeshGroups, when given) to ``path``."""
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
         from .freecad_export import write_via_freecad
 
-        write_via_freecad(path, mesh)
+        write_via_freecad(path, mesh, groups)
     else:
         from .volume_io import write_tet_mesh
 
         _check_stored(path, mesh)
-        write_tet_mesh(path, mesh, surface)
+        write_tet_mesh(path, mesh, groups)
 
 
 def _check_stored(path, mesh):
@@ -201,7 +202,7 @@ def _write_intersections(path, exc):
 def _mesh_cad_fem(args, progress):
     """The default for a CAD file: the FEM path (FemBspTet.fem.cad_mesh, no FreeCAD): the CAD
     surface meshed at the size, the exact core, refinement with points and tet10 mid-nodes on
-    the CAD. Returns (mesh, stats, boundary surface with CAD face tags)."""
+    the CAD. Returns (mesh, stats, MeshGroups: CAD faces and solids)."""
     unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
                                             ("--radius-edge", args.radius_edge),
                                             ("--thickness-ratio", args.thickness_ratio),
@@ -223,7 +224,18 @@ def _mesh_cad_fem(args, progress):
 
     result = mesh_cad_file(args.input, size=args.size or 0.0, min_size=args.min_size or 0.0,
                            order=args.order, progress=lambda stage, fraction: progress(stage))
-    return result.mesh, result.stats, result.boundary
+    return result.mesh, result.stats, result.groups
+
+
+def _surface_groups(mesh, surfaces, stats):
+    """Named sets from a tagged input surface (a surface file's tags, a CAD tessellation's
+    faces) when the mesh's boundary is that surface unchanged; None otherwise."""
+    if len(surfaces) != 1 or surfaces[0].face_tags is None or \
+            int(stats.get("boundary_steiner_points", 0)) != 0:
+        return None
+    from .volume_io import surface_groups
+
+    return surface_groups(mesh, surfaces[0])
 
 
 def _cmd_mesh(args):
@@ -235,10 +247,10 @@ def _cmd_mesh(args):
     if fem_path:
         progress("reading the CAD file")
         try:
-            mesh, stats, boundary = _mesh_cad_fem(args, progress)
+            mesh, stats, groups = _mesh_cad_fem(args, progress)
         finally:
             progress.finish()
-        return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None, boundary=boundary)
+        return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None, groups=groups)
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
     from . import core
@@ -289,10 +301,12 @@ def _cmd_mesh(args):
     return _finish_mesh(args, progress, t0, mesh, stats, surfaces)
 
 
-def _finish_mesh(args, progress, t0, mesh, stats, surfaces, boundary=None):
+def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
     progress("writing")
+    if groups is None and surfaces is not None and args.output:
+        groups = _surface_groups(mesh, surfaces, stats)
     for out in args.output:
-        write_output(out, mesh, boundary)
+        write_output(out, mesh, groups)
     progress.finish()
     stats["seconds_total"] = time.perf_counter() - t0
     for note in stats.get("notes", []):

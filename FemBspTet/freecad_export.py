@@ -69,19 +69,21 @@ def signed_volumes6(points, tets):
 # TetMesh <-> FemMesh
 # --------------------------------------------------------------------------------------------
 
-def tetmesh_to_femmesh(mesh, face_groups=None):
+def tetmesh_to_femmesh(mesh, groups=None, group_prefix=""):
     """Build a ``Fem.FemMesh`` (SMESH orientation, 1-based ids) from a positively oriented TetMesh.
 
-    mesh:        :class:`TetMesh` with (m, 4) or (m, 10) tets, positively oriented.
-    face_groups: optional ``{name: node indices}`` (0-based indices into ``mesh.points``, e.g.
-                 ``{"Face1": [...]}``); each becomes a FemMesh node group of that name.
+    mesh:         :class:`TetMesh` with (m, 4) or (m, 10) tets, positively oriented.
+    groups:       optional :class:`~FemBspTet.mesh_types.MeshGroups`: the CAD faces' triangles
+                  become FemMesh faces (tria3, or tria6 for tet10; ids m + 1, m + 2, ...), and
+                  each CAD face a "Face" group of them and a "Node" group of their nodes, each
+                  solid (if ``groups.tet_solid`` is given) a "Volume" group, named
+                  ``group_prefix + name`` (``Face3``, ``Solid1``).
 
     Nodes get ids 1..n in ``mesh.points`` order, volumes ids 1..m in ``mesh.tets`` order. Uses
     ``FemMesh.addVolumeList`` where FreeCAD has it (1.0+), else ``addVolume`` per tet (0.20).
 
-    Raises InputError for non-finite coordinates, out-of-range node indices, tets that are not
-    positively oriented (zero or negative volume; the message names the first one), or bad
-    group indices.
+    Raises InputError for non-finite coordinates, out-of-range node indices, or tets that are
+    not positively oriented (zero or negative volume; the message names the first one).
     """
     from .freecad_env import import_freecad
 
@@ -90,7 +92,7 @@ def tetmesh_to_femmesh(mesh, face_groups=None):
 
     _validate_tetmesh(mesh)
     fem = Fem.FemMesh()
-    _fill_femmesh(fem, mesh, face_groups)
+    _fill_femmesh(fem, mesh, groups, group_prefix)
     return fem
 
 
@@ -116,8 +118,9 @@ def _validate_tetmesh(mesh):
             where=where)
 
 
-def _fill_femmesh(fem, mesh, face_groups=None):
-    """Add the nodes, volumes and node groups of ``mesh`` to an empty FemMesh ``fem``."""
+def _fill_femmesh(fem, mesh, groups=None, group_prefix=""):
+    """Add the nodes and volumes of ``mesh``, and the faces and groups of ``groups``, to an
+    empty FemMesh ``fem``."""
     pts, tets = mesh.points, mesh.tets
     add_node = fem.addNode
     for i, (x, y, z) in enumerate(pts.tolist(), start=1):
@@ -134,15 +137,29 @@ def _fill_femmesh(fem, mesh, face_groups=None):
         for e, row in enumerate(conn, start=1):
             add_volume(row, e)
 
-    for name, nodes in (face_groups or {}).items():
-        idx = np.asarray(list(nodes), dtype=np.int64).reshape(-1)
-        if len(idx) and (idx.min() < 0 or idx.max() >= len(pts)):
-            raise InputError("node group %r has node indices outside 0..%d"
-                             % (name, len(pts) - 1), where=mesh.source or "mesh")
-        gid = fem.addGroup(str(name), "Node")
-        if len(idx):
-            fem.addGroupElements(gid, (np.unique(idx) + 1).tolist())
+    if groups is not None:
+        _add_groups(fem, mesh, groups, group_prefix)
     return fem
+
+
+def _add_groups(fem, mesh, groups, prefix):
+    """The faces and groups of :func:`tetmesh_to_femmesh`."""
+    from .volume_io import _checked_groups
+
+    sets = _checked_groups(mesh.source or "mesh", groups, mesh.points, mesh.tets)
+    m = len(mesh.tets)
+    face_ids = np.arange(m + 1, m + 1 + len(sets.tri))
+    add_face = fem.addFace
+    for e, row in zip(face_ids.tolist(), (sets.tri + 1).tolist()):
+        add_face(row, e)
+    for t in sets.faces().tolist():
+        rows = np.flatnonzero(sets.tags == t)
+        name = prefix + sets.face_names[t]
+        fem.addGroupElements(fem.addGroup(name, "Face"), face_ids[rows].tolist())
+        fem.addGroupElements(fem.addGroup(name, "Node"), (np.unique(sets.tri[rows]) + 1).tolist())
+    for t in sets.solids().tolist() if groups.tet_solid is not None else ():
+        fem.addGroupElements(fem.addGroup(prefix + sets.solid_names[t], "Volume"),
+                             (np.flatnonzero(sets.solid == t) + 1).tolist())
 
 
 def femmesh_to_tetmesh(femmesh, source=""):
@@ -207,16 +224,17 @@ def _format_of(path):
     return ext
 
 
-def write_via_freecad(path, mesh):
-    """Write ``mesh`` (a :class:`TetMesh`) with FreeCAD's writer chosen by the extension of
-    ``path``: the FemMesh of :func:`tetmesh_to_femmesh`, written by :func:`write_femmesh`.
+def write_via_freecad(path, mesh, groups=None):
+    """Write ``mesh`` (a :class:`TetMesh`; with the faces and groups of ``groups``, a
+    MeshGroups, when given) with FreeCAD's writer chosen by the extension of ``path``: the
+    FemMesh of :func:`tetmesh_to_femmesh`, written by :func:`write_femmesh`.
 
     Raises InputError for an unsupported extension, a missing or unwritable directory, or an
     invalid mesh; InternalError if FreeCAD's writer fails or writes nothing.
     """
     path = os.fspath(path)
     _check_target(path)
-    return write_femmesh(path, tetmesh_to_femmesh(mesh))
+    return write_femmesh(path, tetmesh_to_femmesh(mesh, groups))
 
 
 def _check_target(path):

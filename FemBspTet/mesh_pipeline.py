@@ -35,7 +35,7 @@ import time
 import numpy as np
 
 from .errors import Cancelled, InputError, InternalError, MeshingCancelled
-from .mesh_types import TetMesh
+from .mesh_types import MeshGroups, TetMesh
 
 #: FreeCAD property name of each MeshParameters field (for messages that name what to change).
 PROPERTY_OF = {
@@ -66,7 +66,7 @@ REMOVED_BECAUSE = ("the mesher meshes the CAD faces itself at the element size "
                    "node and tet10 mid-node on the CAD, so tessellation, quality-bound, "
                    "thin-wall and mid-node options have no meaning; drop them")
 
-#: Prefix of the FemMesh node group made for each CAD face (``BspTet_Face3``). FEM's CalculiX
+#: Prefix of the FemMesh face and node groups made for each CAD face (``BspTet_Face3``). FEM's CalculiX
 #: writer only uses groups named ``<constraint object name>_...``; this prefix avoids them.
 FACE_GROUP_PREFIX = "BspTet_"
 
@@ -95,7 +95,8 @@ class MeshParameters:
                     bounding-box diagonal / 20, lowered on curved faces and edges.
     min_size:       smallest element size (CharacteristicLengthMin); 0 = h / 50.
     order:          1 (tet4) or 2 (tet10, boundary mid-nodes on the CAD faces and edges).
-    face_groups:    one FemMesh node group per CAD face (``BspTet_Face<k>``).
+    face_groups:    the boundary triangles as FemMesh faces, and per CAD face a face group and
+                    a node group (``BspTet_Face<k>``).
     compare_tetgen: also run ``tetgen -pY`` on OpenCASCADE's display tessellation of the shape
                     and report its counts.
     """
@@ -185,10 +186,15 @@ class MeshResult:
             parts.append(self.boundary_midnodes[sel].reshape(-1))
         return np.unique(np.concatenate(parts))
 
-    def face_node_groups(self):
-        """``{"BspTet_Face<k>": node indices}`` for every CAD face with boundary triangles."""
-        return {FACE_GROUP_PREFIX + self.face_names[t]: self.face_nodes(t)
-                for t in np.unique(self.boundary_face_tags).tolist()}
+    def groups(self):
+        """The boundary triangles (with their mid-nodes) per CAD face as
+        :class:`~FemBspTet.mesh_types.MeshGroups` (no solid numbers: the tets' solids are not
+        kept)."""
+        tri = self.boundary_faces
+        if len(self.boundary_midnodes):
+            tri = np.column_stack([tri, self.boundary_midnodes])
+        return MeshGroups(face_triangles=tri, face_tags=self.boundary_face_tags,
+                          face_names=list(self.face_names))
 
     # -- files (the worker process hands its result over through these) ---------------------
 

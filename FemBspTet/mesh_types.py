@@ -71,3 +71,47 @@ class TetMesh:
     @property
     def order(self):
         return 2 if self.tets.shape[1] == 10 else 1
+
+
+@dataclass
+class MeshGroups:
+    """Named groups of a :class:`TetMesh`, as the CAD defines them; the writers turn them into
+    each format's sets (``.inp`` ``*NSET`` / ``*ELSET`` / ``*SURFACE``, ``.msh`` physical
+    groups, ``.vtu`` cell data, Medit references, TetGen region attributes).
+
+    face_triangles: (k, 3) or (k, 6) int64, 0-based mesh nodes of the triangles of the CAD faces
+                    (corners, then for tet10 the mid-edge nodes ``m_ab, m_bc, m_ca``); a face
+                    between two solids is listed once
+    face_tags:      (k,) int32, 0-based CAD face of each triangle (``shape.Faces[tag]``)
+    face_names:     name of each face tag (``"Face1"`` for tag 0 unless the CAD names it)
+    tet_solid:      (m,) int32 or None, 0-based CAD solid of each tet
+    solid_names:    name of each solid index (``"Solid1"`` for index 0 unless the CAD names it)
+    """
+
+    face_triangles: np.ndarray
+    face_tags: np.ndarray
+    face_names: List[str]
+    tet_solid: Optional[np.ndarray] = None
+    solid_names: Optional[List[str]] = None
+
+    def __post_init__(self):
+        tri = np.asarray(self.face_triangles, dtype=np.int64)
+        self.face_triangles = np.ascontiguousarray(tri.reshape(-1, tri.shape[-1] if tri.ndim == 2
+                                                               else 3))
+        self.face_tags = np.ascontiguousarray(self.face_tags, dtype=np.int32).reshape(-1)
+        if len(self.face_tags) != len(self.face_triangles):
+            raise ValueError("face_tags must give one tag per face triangle")
+        if self.face_tags.size and (self.face_tags.min() < 0
+                                    or self.face_tags.max() >= len(self.face_names)):
+            raise ValueError("a face tag has no name")
+        if self.tet_solid is not None:
+            self.tet_solid = np.ascontiguousarray(self.tet_solid, dtype=np.int32).reshape(-1)
+            names = self.solid_names or []
+            if self.tet_solid.size and (self.tet_solid.min() < 0
+                                        or self.tet_solid.max() >= len(names)):
+                raise ValueError("a tet's solid has no name")
+
+    @staticmethod
+    def default_names(prefix, count):
+        """``[prefix + "1", prefix + "2", ...]``: FreeCAD's names of a shape's sub-elements."""
+        return [f"{prefix}{i + 1}" for i in range(count)]

@@ -44,7 +44,8 @@ PARAMETER_PROPERTIES = (
      "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
      ("1st", "2nd")),
     ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
-     "Make a node group per CAD face (BspTet_Face1, ...)", False),
+     "Add the boundary triangles as faces, and a face group and a node group per CAD face "
+     "(BspTet_Face1, ...)", False),
     ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
      "Also run tetgen -pY on OpenCASCADE's display tessellation of the part and show its "
      "counts", True),

@@ -66,11 +66,13 @@ def record_failure(obj, error):
 
 
 def femmesh_of(result, face_groups):
-    """The ``Fem.FemMesh`` of a MeshResult (SMESH conventions; node groups per CAD face if
-    ``face_groups``)."""
+    """The ``Fem.FemMesh`` of a MeshResult (SMESH conventions; if ``face_groups``, the boundary
+    triangles as faces and per CAD face a face group and a node group ``BspTet_Face<k>``)."""
     from .freecad_export import tetmesh_to_femmesh
+    from .mesh_pipeline import FACE_GROUP_PREFIX
 
-    return tetmesh_to_femmesh(result.mesh, result.face_node_groups() if face_groups else None)
+    return tetmesh_to_femmesh(result.mesh, result.groups() if face_groups else None,
+                              group_prefix=FACE_GROUP_PREFIX)
 
 
 def apply_result(obj, result, femmesh=None):

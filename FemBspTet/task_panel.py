@@ -55,7 +55,7 @@ class TaskPanelMeshBspTet:
         self.cb_order = QtGui.QComboBox()
         self.cb_order.addItems(["1st", "2nd"])
         grid.addRow("Element order", self.cb_order)
-        self.ck_groups = QtGui.QCheckBox("Node group per CAD face")
+        self.ck_groups = QtGui.QCheckBox("Face and node groups per CAD face")
         self.ck_tetgen = QtGui.QCheckBox("Compare with tetgen -pY")
         self.ck_tetgen.setToolTip("tetgen -pY on OpenCASCADE's display tessellation of the part "
                                   "(our mesh is made from the CAD faces themselves)")

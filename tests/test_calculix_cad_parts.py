@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """CalculiX's own verdict on our tet10 meshes of CAD parts, with no FreeCAD: each part of
 tests/data/cad meshed by the FEM path at its automatic size, one CAD face fixed and another
-loaded per group of connected solids (FemBspTet.fem.calculix_load_case), solved by ccx. CalculiX
+loaded per group of connected solids through the mesh file's named sets
+(FemBspTet.fem.calculix_load_case), solved by ccx. CalculiX
 refuses an element whose Jacobian is not positive at its integration points; the solve must
 finish, with finite displacements, the fixed faces not moving and the loaded ones moving."""
 
@@ -35,6 +36,16 @@ def test_calculix_solves_a_face_load_on_our_tet10_mesh(part, tmp_path):
         assert np.linalg.norm(disp[_face_nodes(result, face - 1)], axis=1).max() > 0
     for face in figures["fixed_faces"]:
         assert np.abs(disp[_face_nodes(result, face - 1)]).max() == 0.0
+    # the load went through the named sets only: the pressure on the *SURFACE's element faces
+    # is balanced by the reaction on the fixed *NSET (a wrong element face number S1..S4 would
+    # put the pressure on other faces, with another resultant)
+    applied, reaction = np.array(figures["applied_force"]), np.array(figures["reaction_force"])
+    assert figures["loads_touching_fixed_faces"] == 0
+    if figures["loaded_faces"]:
+        # 1000 N per loaded face; the resultants of several groups may cancel in the sum
+        assert np.linalg.norm(applied + reaction) <= 1e-6 * 1000.0 * len(figures["loaded_faces"])
+    deck = open(os.path.join(tmp_path, "job.inp")).read()
+    assert "*CLOAD" not in deck and "*DSLOAD" in deck
     with open(os.path.join(tmp_path, "job.inp")) as deck:  # CalculiX reads 20-character fields
         assert all(len(field.strip()) <= 20 for line in deck if not line.startswith("*")
                    for field in line.split(","))

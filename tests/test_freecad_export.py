@@ -210,17 +210,26 @@ def test_tetmesh_to_femmesh_rejects_bad_meshes(Fem, change, pattern):
         fx.tetmesh_to_femmesh(TetMesh(pts, tets, source="bad"))
 
 
-def test_face_node_groups(Fem):
+def test_groups_become_faces_and_named_groups(Fem):
+    from FemBspTet.core import boundary_surface
+    from FemBspTet.mesh_types import MeshGroups
+
     mesh = cube_tet4()
-    x0 = np.nonzero(mesh.points[:, 0] == mesh.points[:, 0].min())[0]
-    fem = fx.tetmesh_to_femmesh(mesh, face_groups={"Face1": x0, "Empty": []})
-    groups = {fem.getGroupName(g): g for g in fem.Groups}
-    assert set(groups) == {"Face1", "Empty"}
-    assert fem.getGroupElementType(groups["Face1"]) == "Node"
-    assert sorted(fem.getGroupElements(groups["Face1"])) == sorted((x0 + 1).tolist())
-    assert len(fem.getGroupElements(groups["Empty"])) == 0
-    with pytest.raises(InputError, match=r"node group 'Bad' has node indices outside 0..7"):
-        fx.tetmesh_to_femmesh(mesh, face_groups={"Bad": [3, 8]})
+    tri = boundary_surface(mesh).triangles
+    x = mesh.points[tri][:, :, 0]
+    tags = np.where((x == x.min()).all(axis=1), 0, 1)
+    groups = MeshGroups(tri, tags, ["Face1", "Rest"], np.zeros(len(mesh.tets)), ["Solid1"])
+    fem = fx.tetmesh_to_femmesh(mesh, groups, group_prefix="P_")
+    assert fem.FaceCount == len(tri) and fem.VolumeCount == len(mesh.tets)
+    named = {(fem.getGroupName(g), fem.getGroupElementType(g)): sorted(fem.getGroupElements(g))
+             for g in fem.Groups}
+    assert set(named) == {("P_Face1", "Node"), ("P_Face1", "Face"), ("P_Rest", "Node"),
+                          ("P_Rest", "Face"), ("P_Solid1", "Volume")}
+    x0 = np.flatnonzero(mesh.points[:, 0] == mesh.points[:, 0].min())
+    assert named[("P_Face1", "Node")] == (x0 + 1).tolist()
+    face_nodes = {tuple(sorted(fem.getElementNodes(e))) for e in named[("P_Face1", "Face")]}
+    assert face_nodes == {tuple(sorted((t + 1).tolist())) for t in tri[tags == 0]}
+    assert named[("P_Solid1", "Volume")] == list(range(1, len(mesh.tets) + 1))
 
 
 def test_addvolumelist_path_when_freecad_has_it(Fem):
@@ -355,7 +364,7 @@ def test_failed_write_keeps_existing_file_and_leaves_nothing(Fem, tmp_path, monk
                 f.write(b"partial")
             raise RuntimeError("disk full")
 
-    monkeypatch.setattr(fx, "tetmesh_to_femmesh", lambda mesh: HalfWriter())
+    monkeypatch.setattr(fx, "tetmesh_to_femmesh", lambda mesh, groups=None: HalfWriter())
     with pytest.raises(InternalError, match="disk full"):
         fx.write_via_freecad(path, cube_tet4())
     assert path.read_bytes() == b"previous mesh"
@@ -365,7 +374,7 @@ def test_failed_write_keeps_existing_file_and_leaves_nothing(Fem, tmp_path, monk
         def write(self, name):
             pass
 
-    monkeypatch.setattr(fx, "tetmesh_to_femmesh", lambda mesh: SilentWriter())
+    monkeypatch.setattr(fx, "tetmesh_to_femmesh", lambda mesh, groups=None: SilentWriter())
     with pytest.raises(InternalError, match="produced no file"):
         fx.write_via_freecad(path, cube_tet4())
     assert path.read_bytes() == b"previous mesh"

@@ -341,7 +341,9 @@ def test_mesh_shape_returns_a_femmesh(fc):
     assert np.all(smesh_signed_volumes(fem) < 0)
     fem1 = FemBspTet.mesh_shape(Part.makeBox(3, 4, 5), order=1, face_groups=True,
                                 CharacteristicLengthMax=2)
-    assert len(fem1.getElementNodes(fem1.Volumes[0])) == 4 and fem1.GroupCount == 6
+    assert len(fem1.getElementNodes(fem1.Volumes[0])) == 4 and fem1.GroupCount == 12
+    kinds = sorted(fem1.getGroupElementType(g) for g in fem1.Groups)
+    assert kinds == ["Face"] * 6 + ["Node"] * 6 and fem1.FaceCount > 0
     nodes = fem1.Nodes
     longest = max((nodes[a] - nodes[b]).Length for e in fem1.Volumes
                   for a in fem1.getElementNodes(e) for b in fem1.getElementNodes(e))
@@ -415,7 +417,8 @@ def test_save_and_reload(doc, fc, tmp_path):
         f2 = o2.FemMesh
         assert {i: tuple(v) for i, v in f2.Nodes.items()} == nodes
         assert [f2.getElementNodes(e) for e in f2.Volumes] == vols
-        assert f2.GroupCount == faces
+        assert f2.GroupCount == 2 * faces  # a face group and a node group per CAD face
+        assert f2.FaceCount == fem.FaceCount > 0
         assert o2.Nodes == len(nodes) and o2.MeshStatus.startswith("meshed")
         # the former parameters went on opening; the object meshes as before
         assert "RemeshSurface" not in o2.PropertiesList

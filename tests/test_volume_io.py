@@ -20,8 +20,8 @@ import pytest
 from FemBspTet import volume_io
 from FemBspTet.errors import InputError, InternalError
 from FemBspTet.mesh_types import Surface, TetMesh
-from FemBspTet.volume_io import (read_tet_mesh, read_tetgen, stored_points, tetgen_paths,
-                                 write_tet_mesh)
+from FemBspTet.volume_io import (read_tet_mesh, read_tetgen, stored_points, surface_groups,
+                                 tetgen_paths, write_tet_mesh)
 
 
 # our mid-edge node 4 + k lies on the edge _EDGES[k] (0-based corners)
@@ -245,7 +245,7 @@ def test_boundary_triangles_with_tags(tmp_path, ext, kind):
     mesh = MESHES[kind]()
     surface = box_surface(kuhn_box())
     path = tmp_path / f"s{ext}"
-    write_tet_mesh(path, mesh, surface)
+    write_tet_mesh(path, mesh, surface_groups(mesh, surface))
     back = read_tet_mesh(path)
     assert np.array_equal(back.tets, mesh.tets)
     tri = back.extra["triangles"]
@@ -258,7 +258,7 @@ def test_boundary_triangles_with_tags(tmp_path, ext, kind):
             assert np.allclose(p[tri[:, 3 + k]], (p[tri[:, a]] + p[tri[:, b]]) / 2)
     if ext == ".msh":
         text = path.read_text()
-        assert '2 1 "Side0"' in text and '3 1 "Solid"' in text
+        assert '2 1 "Side0"' in text and '3 1 "Solid1"' in text
     if kind == "tet4" or ext == ".msh":
         other = _meshio_read(path, ext)
         tri_type = "triangle" if kind == "tet4" else "triangle6"
@@ -276,13 +276,13 @@ def test_surface_matched_by_coordinates(tmp_path):
     inverse = np.argsort(perm)
     shuffled = Surface(surface.points[perm], inverse[surface.triangles],
                        face_tags=surface.face_tags)
-    write_tet_mesh(tmp_path / "s.msh", mesh, shuffled)
+    write_tet_mesh(tmp_path / "s.msh", mesh, surface_groups(mesh, shuffled))
     back = read_tet_mesh(tmp_path / "s.msh")
     assert np.array_equal(back.extra["triangles"], surface.triangles)
     stranger = Surface(np.vstack([surface.points, [[9.0, 9.0, 9.0]]]),
                        np.vstack([surface.triangles, [[0, 1, 8]]]))
     with pytest.raises(InputError) as exc:
-        write_tet_mesh(tmp_path / "x.msh", mesh, stranger)
+        surface_groups(mesh, stranger, where=str(tmp_path / "x.msh"))
     expect_error(exc, "x.msh", "surface vertex 8", "not a node of the mesh")
     assert not (tmp_path / "x.msh").exists()
 
@@ -568,7 +568,7 @@ def test_reads_real_gmsh_output(tmp_path, order, fmt):
 @pytest.mark.parametrize("kind", sorted(MESHES))
 def test_gmsh_reads_what_we_write(tmp_path, kind):
     mesh = MESHES[kind]()
-    write_tet_mesh(tmp_path / "ours.msh", mesh, box_surface(kuhn_box()))
+    write_tet_mesh(tmp_path / "ours.msh", mesh, surface_groups(mesh, box_surface(kuhn_box())))
     subprocess.run(["gmsh", "ours.msh", "-0", "-format", "msh41", "-o", "theirs.msh"],
                    cwd=tmp_path, check=True, capture_output=True, timeout=120)
     back = read_tet_mesh(tmp_path / "theirs.msh")
@@ -718,11 +718,31 @@ def test_msh_errors(tmp_path, text, fragments):
     expect_error(exc, path, *fragments)
 
 
+def ascii_vtu(mesh):
+    """An ASCII VTU of a tet4 mesh, as other programs write it (we write binary)."""
+    m = len(mesh.tets)
+    rows = "".join(" ".join(map(str, t)) + "\n" for t in mesh.tets.tolist())
+    pts = "".join(" ".join(map(repr, p)) + "\n" for p in mesh.points.tolist())
+    return ('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1" '
+            'byte_order="LittleEndian">\n  <UnstructuredGrid>\n'
+            f'    <Piece NumberOfPoints="{len(mesh.points)}" NumberOfCells="{m}">\n'
+            '      <Points>\n        <DataArray type="Float64" NumberOfComponents="3" '
+            f'format="ascii">\n{pts}        </DataArray>\n      </Points>\n      <Cells>\n'
+            '        <DataArray type="Int64" Name="connectivity" format="ascii">\n'
+            f'{rows}        </DataArray>\n'
+            '        <DataArray type="Int64" Name="offsets" format="ascii">\n'
+            + "".join(f"{4 * (i + 1)}\n" for i in range(m)) + '        </DataArray>\n'
+            '        <DataArray type="UInt8" Name="types" format="ascii">\n' + "10\n" * m
+            + "        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n"
+            "</VTKFile>\n")
+
+
 def test_vtu_errors(tmp_path):
     mesh = kuhn_box()
+    good = ascii_vtu(mesh)
     path = tmp_path / "good.vtu"
-    write_tet_mesh(path, mesh)
-    good = path.read_text()
+    path.write_text(good)
+    assert np.array_equal(read_tet_mesh(path).tets, mesh.tets)
     cases = [
         (good.replace("</Points>", "", 1), ["not valid XML", "line"]),
         (good.replace('Name="connectivity"', 'Name="conn"'), ["no DataArray named"]),
@@ -839,15 +859,17 @@ def test_failed_write_keeps_previous_files(tmp_path, monkeypatch, ext):
     write_tet_mesh(target, old)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     calls = []
-    real = volume_io._format_rows
+    # the function that formats each block of data (VTU: each binary array)
+    name = "_vtu_binary" if ext == ".vtu" else "_format_rows"
+    real = getattr(volume_io, name)
 
-    def fail_late(fmt, arr):
-        calls.append(fmt)
+    def fail_late(*args):
+        calls.append(args[0])
         if len(calls) == 2:  # the first block is already written when this fails
             raise OSError("disk full (simulated)")
-        return real(fmt, arr)
+        return real(*args)
 
-    monkeypatch.setattr(volume_io, "_format_rows", fail_late)
+    monkeypatch.setattr(volume_io, name, fail_late)
     with pytest.raises(OSError):
         write_tet_mesh(target, quadratic(old))
     assert len(calls) == 2

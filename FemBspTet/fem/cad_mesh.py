@@ -5,6 +5,7 @@
     result.mesh          # TetMesh: points, tets (m, 4) or (m, 10)
     result.tet_solid     # (m,) 0-based CAD solid of each tet
     result.boundary      # Surface: the boundary triangles (corners), face_tags = 0-based CAD face
+    result.groups        # MeshGroups: every CAD face's triangles (Face1, ...), each tet's solid
     result.stats         # dict (see the native mesh_cad_file)
 
 The work is the native pipeline (``cpp_module/include/bsptet/fem/fem_mesh.h``): every CAD edge and
@@ -18,7 +19,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import InputError
-from ..mesh_types import Surface, TetMesh
+from ..mesh_types import MeshGroups, Surface, TetMesh
 
 
 @dataclasses.dataclass
@@ -29,6 +30,9 @@ class CadMeshResult:
     #: (k, 3) tet10 mid-nodes of the boundary triangles' edges (a,b), (b,c), (c,a); (0, 3) for tet4
     boundary_midnodes: np.ndarray
     stats: dict
+    #: named sets for the writers: the triangles of every CAD face (a face between two solids
+    #: too), named ``Face<n>`` as FreeCAD names ``shape.Faces[n - 1]``; solids ``Solid<n>``
+    groups: MeshGroups = None
 
 
 def _row_keys(triples):
@@ -153,8 +157,14 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
                  input_triangles=int(stats["surface_triangles"]),
                  boundary_steiner_points=0, steiner_points=int(stats["core_steiner_points"]))
     midnodes = tri[on_boundary, 3:6] if tri.shape[1] == 6 else np.zeros((0, 3), dtype=np.int64)
+    tri_face = np.asarray(tri_face, dtype=np.int64)
+    faces = max(int(stats["faces"]), int(tri_face.max()) + 1 if len(tri_face) else 0)
+    solids = max(int(stats["solids"]), int(tet_solid.max()) + 1 if len(tet_solid) else 0)
+    groups = MeshGroups(face_triangles=tri, face_tags=tri_face,
+                        face_names=MeshGroups.default_names("Face", faces),
+                        tet_solid=tet_solid, solid_names=MeshGroups.default_names("Solid", solids))
     return CadMeshResult(mesh=mesh, tet_solid=np.asarray(tet_solid), boundary=boundary,
-                         boundary_midnodes=midnodes, stats=stats)
+                         boundary_midnodes=midnodes, stats=stats, groups=groups)
 
 
 def mesh_cad_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,

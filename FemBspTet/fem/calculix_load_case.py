@@ -8,12 +8,17 @@ on the elements (it refuses a tet10 whose Jacobian is not positive at its integr
     result = mesh_cad_file("part.step", order=2)
     figures = solve_face_load(result, "work/")   # InternalError if CalculiX refuses the mesh
 
-The load case, per group of connected solids (solids that share nodes; solids that only touch
-have separate nodes and are separate groups): the group's lowest-numbered CAD face fixed (all
-nodes, mid-nodes included), and its highest-numbered CAD face pushed inward along its mean
-normal with a total force of 1000 N spread equally over its nodes. A group with a single CAD
-face (a sphere) is fixed on it and carries its own weight instead. Steel: E = 210000 MPa,
-nu = 0.3, density 7.9e-9 t/mm^3. Model units are taken as mm.
+The mesh is written with its named sets (``Face<n>`` node sets and element-face surfaces,
+``Solid<n>`` element sets, as ``fembsptet mesh`` writes them) and the load case refers to them by
+name only. Per group of connected solids (solids that share nodes; solids that only touch have
+separate nodes and are separate groups): the group's lowest-numbered CAD face fixed
+(``*BOUNDARY``, all its nodes, mid-nodes included), and a pressure (``*DSLOAD``) of 1000 N over
+the face's area on the other face whose pressure has the largest resultant (the first such),
+among the faces that share no node with the fixed one when there are such. A group with a single CAD face (a sphere) is
+fixed on it and carries its own weight instead. The solver's reaction on the fixed faces must
+balance the pressure's resultant (integrated exactly over the mesh's faces, curved tet10 faces
+included), which also checks that each element face of the surfaces is the right one. Steel:
+E = 210000 MPa, nu = 0.3, density 7.9e-9 t/mm^3. Model units are taken as mm.
 """
 
 import math
@@ -64,20 +69,30 @@ def _face_nodes(result, face):
     return np.unique(np.concatenate(nodes))
 
 
-def _mean_outward_normal(result, face):
-    tri = result.boundary.triangles[result.boundary.face_tags == face]
-    p = result.mesh.points
-    n = np.cross(p[tri[:, 1]] - p[tri[:, 0]], p[tri[:, 2]] - p[tri[:, 0]]).sum(axis=0)
-    length = float(np.linalg.norm(n))
-    return n / length if length > 0 else np.array([0.0, 0.0, 1.0])
+def _face_triangles(result, face):
+    """The CAD face's triangles (corners, then tet10 mid-nodes m_ab, m_bc, m_ca)."""
+    groups = result.groups
+    return groups.face_triangles[groups.face_tags == face]
 
 
-def _set_lines(name, ids):
-    out = [f"*NSET, NSET={name}\n"]
-    ids = (np.asarray(ids) + 1).tolist()
-    for i in range(0, len(ids), 16):
-        out.append(", ".join(str(v) for v in ids[i:i + 16]) + "\n")
-    return out
+def _area_vector(points, tri):
+    """Sum over the triangles of the integral of the (unnormalized, right-hand) normal: exact for
+    flat (3-node) and quadratic (6-node) triangles. The quadratic map's tangents are linear, so
+    their cross product is quadratic, integrated exactly by the edge-midpoint rule."""
+    p = points[tri]
+    if tri.shape[1] == 3:
+        return 0.5 * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]).sum(axis=0)
+    a, b, c, ab, bc, ca = (p[:, k] for k in range(6))
+    total = np.zeros(3)
+    for xi, eta in ((0.5, 0.0), (0.5, 0.5), (0.0, 0.5)):
+        # x(xi, eta), xi toward b, eta toward c (quadratic Lagrange shape functions)
+        l0 = 1.0 - xi - eta
+        dxi = (a * (1 - 4 * l0) + b * (4 * xi - 1) + ab * (4 * (l0 - xi))
+               + bc * (4 * eta) - ca * (4 * eta))
+        deta = (a * (1 - 4 * l0) + c * (4 * eta - 1) - ab * (4 * xi)
+                + bc * (4 * xi) + ca * (4 * (l0 - eta)))
+        total += np.cross(dxi, deta).sum(axis=0) / 6.0
+    return total
 
 
 def _read_displacements(dat_path):
@@ -99,10 +114,27 @@ def _read_displacements(dat_path):
     return u
 
 
+def _read_totals(dat_path):
+    """{set name (upper case): (fx, fy, fz)} from CalculiX's .dat (*NODE PRINT, TOTALS=ONLY, RF)."""
+    totals, name = {}, None
+    with open(dat_path, errors="replace") as f:
+        for line in f:
+            m = re.match(r"\s*total force \(fx,fy,fz\) for set (\S+)", line)
+            if m:
+                name = m.group(1)
+                continue
+            parts = line.split()
+            if name and len(parts) == 3:
+                totals[name] = tuple(float(x.replace("D", "E")) for x in parts)
+                name = None
+    return totals
+
+
 def solve_face_load(result, workdir, ccx=None, timeout=1800):
     """Writes the mesh and the load case (module doc) into `workdir`, runs CalculiX and returns
     {"groups", "fixed_faces", "loaded_faces", "nodes", "elements", "max_displacement",
-    "seconds"}. Raises InternalError with CalculiX's message when it refuses or fails, or when a
+    "seconds", "applied_force" (the pressures' resultant), "reaction_force" (on the fixed
+    faces; it balances the applied force when "loads_touching_fixed_faces" is 0)}. Raises InternalError with CalculiX's message when it refuses or fails, or when a
     displacement is not finite or a fixed node moved."""
     import time
 
@@ -112,43 +144,54 @@ def solve_face_load(result, workdir, ccx=None, timeout=1800):
     os.makedirs(workdir, exist_ok=True)
     mesh = result.mesh
     order = 2 if mesh.tets.shape[1] == 10 else 1
-    write_tet_mesh(os.path.join(workdir, "mesh.inp"), mesh)
-    faces_of_solid_nodes = []
+    groups = result.groups
+    write_tet_mesh(os.path.join(workdir, "mesh.inp"), mesh, groups)
     lines = ["*INCLUDE, INPUT=mesh.inp\n"]
     fixed, loaded, gravity = [], [], []
+    touching_fixed = 0
+    applied = np.zeros(3)
     node_solid = np.full(len(mesh.points), -1, dtype=np.int64)
     for s in np.unique(result.tet_solid).tolist():
         node_solid[np.unique(mesh.tets[result.tet_solid == s])] = s
-    for k, group in enumerate(_groups_of_solids(mesh.tets, result.tet_solid)):
+    for group in _groups_of_solids(mesh.tets, result.tet_solid):
         in_group = np.isin(node_solid[result.boundary.triangles[:, 0]], group)
         faces = sorted(set(result.boundary.face_tags[in_group].tolist()))
         if not faces:
             raise InternalError(f"solids {group} have no boundary face")
         fixed.append(faces[0])
-        lines += _set_lines(f"FIX{k}", _face_nodes(result, faces[0]))
         if len(faces) > 1:
-            loaded.append(faces[-1])
-            nodes = _face_nodes(result, faces[-1])
-            lines += _set_lines(f"LOAD{k}", nodes)
-            faces_of_solid_nodes.append((k, -_mean_outward_normal(result, faces[-1])
-                                         * TOTAL_FORCE_N / len(nodes)))
+            # the face whose pressure has the largest resultant (a large flat face), among those
+            # with no node on the fixed face if there are any: the load on a fixed node goes
+            # into the support without showing in the reaction
+            fixed_nodes = _face_nodes(result, faces[0])
+            apart = [f for f in faces[1:]
+                     if not np.isin(_face_nodes(result, f), fixed_nodes).any()]
+            touching_fixed += 0 if apart else 1
+            candidates = apart or faces[1:]
+            resultant = [np.linalg.norm(_area_vector(mesh.points, _face_triangles(result, f)))
+                         for f in candidates]
+            loaded.append(candidates[int(np.argmax(resultant))])
         else:
-            lines.append(f"*ELSET, ELSET=BODY{k}\n")
-            ids = (np.flatnonzero(np.isin(result.tet_solid, group)) + 1).tolist()
-            for i in range(0, len(ids), 16):
-                lines.append(", ".join(str(v) for v in ids[i:i + 16]) + "\n")
-            gravity.append(k)
+            gravity += group
     lines += ["*MATERIAL, NAME=STEEL\n", "*ELASTIC\n", "210000, 0.3\n", "*DENSITY\n", "7.9e-9\n",
               "*SOLID SECTION, ELSET=Eall, MATERIAL=STEEL\n", "*STEP\n", "*STATIC\n", "*BOUNDARY\n"]
-    lines += [f"FIX{k}, 1, 3\n" for k in range(len(fixed))]
-    if faces_of_solid_nodes:
-        lines.append("*CLOAD\n")
-        for k, f in faces_of_solid_nodes:
-            lines += [f"LOAD{k}, {d + 1}, {f[d]:.12e}\n" for d in range(3)]  # a 20-character field
+    lines += [f"{groups.face_names[f]}, 1, 3\n" for f in fixed]
+    if loaded:
+        lines.append("*DSLOAD\n")
+        for f in loaded:
+            tri = _face_triangles(result, f)
+            p = mesh.points[tri[:, :3]]
+            area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
+                                        axis=1).sum()
+            pressure = TOTAL_FORCE_N / area
+            lines.append(f"{groups.face_names[f]}, P, {pressure:.12e}\n")
+            applied -= pressure * _area_vector(mesh.points, tri)  # a pressure pushes inward
     if gravity:
         lines.append("*DLOAD\n")
-        lines += [f"BODY{k}, GRAV, 9810., 0., 0., -1.\n" for k in gravity]
-    lines += ["*NODE PRINT, NSET=Nall\n", "U\n", "*END STEP\n"]
+        lines += [f"{groups.solid_names[s]}, GRAV, 9810., 0., 0., -1.\n" for s in gravity]
+    lines += ["*NODE PRINT, NSET=Nall\n", "U\n"]
+    lines += [f"*NODE PRINT, NSET={groups.face_names[f]}, TOTALS=ONLY\nRF\n" for f in fixed]
+    lines.append("*END STEP\n")
     with open(os.path.join(workdir, "job.inp"), "w") as f:
         f.writelines(lines)
     t0 = time.perf_counter()
@@ -178,9 +221,17 @@ def solve_face_load(result, workdir, ccx=None, timeout=1800):
     fixed_nodes = np.concatenate([_face_nodes(result, f) for f in fixed])
     if np.abs(disp[fixed_nodes]).max() != 0.0:
         raise InternalError("a fixed node moved in the CalculiX result")
+    totals = _read_totals(os.path.join(workdir, "job.dat"))
+    missing = [groups.face_names[f] for f in fixed if groups.face_names[f].upper() not in totals]
+    if missing:
+        raise InternalError(f"CalculiX printed no reaction total for {', '.join(missing)} "
+                            f"(see {workdir}/job.dat)")
+    reaction = np.sum([totals[groups.face_names[f].upper()] for f in fixed], axis=0)
     lengths = np.linalg.norm(disp, axis=1)
     return {"groups": len(fixed), "fixed_faces": [f + 1 for f in fixed],
-            "loaded_faces": [f + 1 for f in loaded], "gravity_groups": len(gravity),
+            "loaded_faces": [f + 1 for f in loaded], "gravity_solids": len(gravity),
             "nodes": int(len(mesh.points)), "elements": int(len(mesh.tets)), "order": order,
             "max_displacement": float(lengths.max()), "seconds": seconds,
+            "applied_force": applied.tolist(), "reaction_force": reaction.tolist(),
+            "loads_touching_fixed_faces": touching_fixed,
             "finite": bool(math.isfinite(float(lengths.max())))}
