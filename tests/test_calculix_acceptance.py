@@ -2,7 +2,7 @@
 """CalculiX acceptance of the FreeCAD mesher, headless: the same analysis solved with our
 mesh and with FreeCAD's Gmsh mesh at the same CharacteristicLengthMax.
 
-The acceptance figures of the FreeCAD issue: the cantilever's maximum displacement within 1% of
+The acceptance figures: the cantilever's and the bracket's maximum displacement within 1% of
 Gmsh tet10's at the same CharacteristicLengthMax, the plate with a hole's within 2%.
 Takes about 30 s (Gmsh and ccx on small meshes).
 """
@@ -114,3 +114,12 @@ def test_acceptance_plate_with_hole_within_2_percent_of_gmsh(freecad, tmp_path_f
     ours = solved(freecad, tmp_path_factory, "plate_with_hole", "bsptet", 2)
     a, b = ours["max_displacement_mm"], plate_gmsh["max_displacement_mm"]
     assert abs(a / b - 1) <= 0.02, (a, b)
+
+
+def test_acceptance_bracket_face_load_within_1_percent_of_gmsh(freecad, tmp_path_factory):
+    """The sample bracket, tet10 at the diagonal / 20, its horizontal leg under a pressure."""
+    gmsh = solved(freecad, tmp_path_factory, "bracket", "gmsh", 2)
+    ours = solved(freecad, tmp_path_factory, "bracket", "bsptet", 2)
+    a, b = ours["max_displacement_mm"], gmsh["max_displacement_mm"]
+    assert ours["finite"] and b > 0
+    assert abs(a / b - 1) <= 0.01, (a, b)

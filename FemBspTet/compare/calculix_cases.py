@@ -6,6 +6,10 @@ with our mesh and with FreeCAD's Gmsh mesh at the same size.
   (x = L) (FreeCAD's own cantilever example; Gmsh tet10 at size 500: 88.15 mm).
 * ``plate_with_hole``: steel plate 200 x 100 x 10 mm with a hole of radius 20 mm through its
   centre, Face1 (x = 0) fixed, 100 MPa pressure on the hole's cylindrical face.
+* ``bracket``: the sample L-bracket (``resources/samples/bracket.step``, 80 x 40 x 50 mm, 8 mm
+  legs, a fillet, four holes) at the size of the bounding-box diagonal / 20; the back of its
+  upright leg (Face11, x = 0) fixed, 1 MPa pressure on the top of its horizontal leg (Face8,
+  2540 mm^2): the leg bends.
 
     case = build_case(doc, "cantilever")          # part, analysis, solver, constraints
     mesh = add_bspt_mesh(case, max_size=500, order=2)    or    add_gmsh_mesh(case, 500, 2)
@@ -15,16 +19,25 @@ Needs FreeCAD (Debian freecad-python3), ``ccx`` and ``gmsh`` on PATH.
 """
 
 import math
+import os
 
 from ..errors import InternalError
+
+#: The sample part of the ``bracket`` case.
+BRACKET_STEP = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__)))), "resources", "samples", "bracket.step")
 
 #: Steel, as in freecad.md §6.
 YOUNGS_MODULUS = "210000 MPa"
 POISSON_RATIO = "0.30"
 
 CASES = {
-    "cantilever": {"size": 500.0, "gmsh_reference_mm": 88.15},
-    "plate_with_hole": {"size": 10.0, "hole_radius": 20.0, "pressure_mpa": 100.0},
+    "cantilever": {"size": 500.0, "gmsh_reference_mm": 88.15, "fixed": "Face1"},
+    "plate_with_hole": {"size": 10.0, "hole_radius": 20.0, "pressure_mpa": 100.0,
+                        "fixed": "Face1"},
+    # size: the diagonal of the 80 x 40 x 50 box / 20
+    "bracket": {"size": math.sqrt(80.0 ** 2 + 40.0 ** 2 + 50.0 ** 2) / 20.0, "fixed": "Face11",
+                "pressed": "Face8", "pressure_mpa": 1.0},
 }
 
 
@@ -52,6 +65,9 @@ def build_case(doc, name):
         part = doc.addObject("Part::Feature", "Plate")
         part.Shape = Part.makeBox(200.0, 100.0, 10.0).cut(
             Part.makeCylinder(r, 10.0, FreeCAD.Vector(100.0, 50.0, 0.0)))
+    elif name == "bracket":
+        part = doc.addObject("Part::Feature", "Bracket")
+        part.Shape = Part.read(BRACKET_STEP)
     else:
         raise InternalError("unknown CalculiX case %r (known: %s)" % (name, ", ".join(CASES)))
     doc.recompute()
@@ -70,7 +86,7 @@ def build_case(doc, name):
     analysis.addObject(mat)
 
     fix = ObjectsFem.makeConstraintFixed(doc, "Fixed")
-    fix.References = [(part, "Face1")]  # x = 0 in both cases
+    fix.References = [(part, CASES[name]["fixed"])]
     analysis.addObject(fix)
     if name == "cantilever":
         force = ObjectsFem.makeConstraintForce(doc, "Force")
@@ -81,7 +97,7 @@ def build_case(doc, name):
         analysis.addObject(force)
         loaded = "Face2"
     else:
-        loaded = hole_face_name(part.Shape)
+        loaded = CASES[name].get("pressed") or hole_face_name(part.Shape)
         pressure = ObjectsFem.makeConstraintPressure(doc, "Pressure")
         pressure.References = [(part, loaded)]
         pressure.Pressure = CASES[name]["pressure_mpa"]
