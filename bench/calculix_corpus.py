@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """CalculiX on every CAD part: each part meshed by the FEM path in tet10 at h = bounding-box
-diagonal / D, then one linear static solve per part (per group of connected solids, its first
-CAD face fixed and its last one loaded: FemBspTet/fem/calculix_load_case.py), with no FreeCAD.
+diagonal / D, then one linear static solve per part through the mesh file's named sets (per
+group of connected solids, its first CAD face fixed and a pressure on another:
+FemBspTet/fem/calculix_load_case.py), with no FreeCAD.
 CalculiX refuses elements whose Jacobian is not positive at an integration point; the table says
 which meshes it accepted. Each part runs as its own process with a time limit.
 
@@ -15,6 +16,7 @@ import argparse
 import datetime
 import glob
 import json
+import math
 import os
 import subprocess
 import sys
@@ -96,21 +98,29 @@ def main(argv):
              f" --timeout {args.timeout:g}`",
              f"* Started {started:%Y-%m-%d %H:%M}, took "
              f"{(datetime.datetime.now() - started).total_seconds():.0f} s",
-             "* Each part meshed by the FEM path in tet10 at h = bounding-box diagonal / D; per "
-             "group of connected solids its lowest-numbered CAD face fixed and its "
-             "highest-numbered one loaded (1000 N inward along its mean normal), steel; solved by "
-             "`ccx` (CalculiX 2.20) with no FreeCAD (`FemBspTet/fem/calculix_load_case.py`).",
+             "* Each part meshed by the FEM path in tet10 at h = bounding-box diagonal / D and "
+             "written with its named sets; per group of connected solids its lowest-numbered CAD "
+             "face fixed (`*BOUNDARY` on the face's node set) and a pressure of 1000 N over the "
+             "face's area (`*DSLOAD` on the face's element-face surface) on the face whose "
+             "pressure has the largest resultant among those sharing no node with the fixed "
+             "one; steel; solved by `ccx` (CalculiX 2.20) with no FreeCAD "
+             "(`FemBspTet/fem/calculix_load_case.py`).",
              "* accepted: ccx finished with no error and no \"nonpositive jacobian\", every "
-             "displacement finite, the fixed nodes still.", "",
+             "displacement finite, the fixed nodes still. balance: |reaction on the fixed faces "
+             "+ the pressure's resultant| / 1000 N (equilibrium; a load on a face that touches "
+             "the fixed one is marked *).", "",
              "| part | D | result | h | tets | worst dihedral° | groups | max \\|u\\| mm | "
-             "mesh s | ccx s |", "|---|---|---|---|---|---|---|---|---|---|",]
+             "balance | mesh s | ccx s |", "|---|---|---|---|---|---|---|---|---|---|---|",]
     for name, d, r in rows:
         if r["verdict"] != "accepted":
-            lines.append(f"| {name} | {d} | {r['verdict']} | | | | | | | |")
+            lines.append(f"| {name} | {d} | {r['verdict']} | | | | | | | | |")
             continue
+        gap = [a + b for a, b in zip(r["applied_force"], r["reaction_force"])]
+        balance = (f"{math.sqrt(sum(g * g for g in gap)) / 1000.0:.1e}"
+                   + ("*" if r["loads_touching_fixed_faces"] else ""))
         lines.append(f"| {name} | {d} | accepted | {r['h']:.4g} | {r['tets']} | "
                      f"{r['min_dihedral']:.2f} | {r['groups']} | {r['max_displacement']:.3g} | "
-                     f"{r['mesh_seconds']:.1f} | {r['seconds']:.1f} |")
+                     f"{balance} | {r['mesh_seconds']:.1f} | {r['seconds']:.1f} |")
     accepted = sum(r["verdict"] == "accepted" for _, _, r in rows)
     lines += ["", f"Accepted: {accepted} of {len(rows)} runs.", ""]
     with open(args.out, "w") as f:
