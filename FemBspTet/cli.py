@@ -26,6 +26,8 @@ import sys
 import time
 import traceback
 
+import numpy as np
+
 from . import __version__
 from .errors import BspTetError, InputError, SelfIntersectionError
 from .progress import Progress
@@ -181,8 +183,6 @@ def _check_mesh_args(args):
 
 def _write_intersections(path, exc):
     """Writes the triangles of the intersecting pairs of ``exc`` to ``path`` for viewing."""
-    import numpy as np
-
     from .mesh_types import Surface
     from .surface_io import write_surface
 
@@ -223,7 +223,7 @@ def _mesh_cad_fem(args, progress):
     from .fem.cad_mesh import mesh_cad_file
 
     result = mesh_cad_file(args.input, size=args.size or 0.0, min_size=args.min_size or 0.0,
-                           order=args.order, progress=lambda stage, fraction: progress(stage))
+                           order=args.order, progress=progress)
     return result.mesh, result.stats, result.groups
 
 
@@ -303,11 +303,13 @@ def _cmd_mesh(args):
 
 def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
     progress("writing")
+    t_write = time.perf_counter()
     if groups is None and surfaces is not None and args.output:
         groups = _surface_groups(mesh, surfaces, stats)
     for out in args.output:
         write_output(out, mesh, groups)
     progress.finish()
+    stats["seconds_writing"] = time.perf_counter() - t_write
     stats["seconds_total"] = time.perf_counter() - t0
     for note in stats.get("notes", []):
         print(f"fembsptet: note: {note}", file=sys.stderr)
@@ -316,8 +318,10 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
 
         with atomic_output(args.stats_json) as f:
             json.dump(stats, f, indent=1)
-    if not args.quiet:
+    if args.json:
         print(json.dumps({k: stats.get(k) for k in STATS_KEYS}, indent=1))
+    elif not args.quiet:
+        print(mesh_summary(args.input, args.output, mesh, stats, groups))
     if args.compare_tetgen:
         if surfaces is None:
             from .cad_tessellation import tessellate_file
@@ -325,6 +329,60 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
             surfaces = tessellate_file(args.input, size=args.size)
         print(_tetgen_table(surfaces, stats))
     return 0
+
+
+def _count(n):
+    return f"{int(n):,}"
+
+
+def mesh_summary(source, outputs, mesh, stats, groups):
+    """What a person wants to read at the end of a run: what was read, what was written, the
+    element counts of the written order, the quality figures, where the time went."""
+    order = 2 if mesh.tets.shape[1] == 10 else 1
+    fem_path = "surface_nodes" in stats
+    lines = []
+    if fem_path:
+        lines.append(f"read     {source}: {_count(stats['solids'])} solid(s), "
+                     f"{_count(stats['faces'])} CAD faces; meshed at size {stats['size']:.4g} "
+                     f"(min {stats['min_size']:.3g})")
+    else:
+        lines.append(f"read     {source}: {_count(stats.get('input_points', 0))} points, "
+                     f"{_count(stats.get('input_triangles', 0))} triangles")
+    kind = "tet10" if order == 2 else "tet4"
+    written = f"{_count(len(mesh.points))} nodes, {_count(len(mesh.tets))} {kind} elements"
+    if groups is not None:
+        faces = len(np.unique(groups.face_tags))
+        solids = 1 if groups.tet_solid is None else len(np.unique(groups.tet_solid))
+        written += f"; sets: {faces} CAD face(s), {solids} solid(s)"
+    for out in outputs:
+        lines.append(f"wrote    {out}: {written}")
+    if not outputs:
+        lines.append(f"made     {written} (no file written: give -o FILE)")
+    quality = f"quality  worst dihedral {stats.get('min_dihedral_deg', float('nan')):.1f} deg"
+    if stats.get("p1_dihedral_deg") is not None:
+        quality += f", 1% of angles under {stats['p1_dihedral_deg']:.1f}"
+    if "median_tet_min_dihedral_deg" in stats:
+        quality += (f", median per-tet worst {stats['median_tet_min_dihedral_deg']:.1f} deg, "
+                    f"{stats.get('tets_below_10_deg', 0.0):.2f}% under 10 deg")
+    if stats.get("max_radius_edge_ratio") is not None:
+        quality += f"; worst radius-edge ratio {stats['max_radius_edge_ratio']:.3g}"
+    lines.append(quality)
+    if not fem_path:
+        lines.append(f"points   Steiner {_count(stats.get('steiner_points', 0))} (on the surface "
+                     f"{_count(stats.get('boundary_steiner_points', 0))})")
+    parts = [(name, stats[key]) for name, key in (
+        ("surface", "seconds_surface"), ("core", "seconds_core"), ("refine", "seconds_refine"),
+        ("merge", "seconds_merge"), ("writing", "seconds_writing")) if key in stats]
+    total = stats.get("seconds_total", 0.0)
+    if not fem_path:  # the core's stages: the four longest
+        stages = sorted((stats.get("seconds_by_stage") or {}).items(), key=lambda kv: -kv[1])
+        parts = [(k.replace("_", " "), v) for k, v in stages[:4] if v >= 0.005] + \
+            [(k, v) for k, v in parts if k == "writing"]
+    other = total - sum(v for _, v in parts)
+    timing = ", ".join(f"{k} {v:.2f}" for k, v in parts)
+    lines.append(f"time     {total:.2f} s" + (f" ({timing}, the rest {other:.2f})"
+                                              if parts else ""))
+    return "\n".join(lines)
 
 
 def _tetgen_table(surfaces, stats):
@@ -499,7 +557,9 @@ def build_parser():
     m.add_argument("--order", type=int, choices=(1, 2), default=1,
                    help="element order (2: 10-node tets)")
     m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
-    m.add_argument("--quiet", action="store_true", help="no progress bar and no statistics on stdout")
+    m.add_argument("--quiet", action="store_true", help="no progress and no summary")
+    m.add_argument("--json", action="store_true",
+                   help="print the statistics as JSON on stdout instead of the summary")
     m.add_argument("--allow-boundary-steiner", action="store_true",
                    help="keep Steiner points on the surface where they are exactly doubles "
                         "(default: none on the surface, as tetgen -Y)")
@@ -605,11 +665,8 @@ def _run_reporting(func, args):
         return 1
 
 
-def _supervised_mesh(args):
-    """``mesh`` in a supervised child process (timeout, Ctrl-C, memory, crashes: supervisor.py)."""
-    from .supervisor import Limits, run_supervised
-
-    _check_mesh_args(args)
+def _mesh_outputs(args):
+    """Every file a mesh run may write (the supervisor removes their temporaries)."""
     outputs = list(args.output)
     for extra in (args.stats_json, args.write_intersections):
         if extra:
@@ -617,17 +674,36 @@ def _supervised_mesh(args):
     for out in args.output:  # TetGen output is two files
         if _ext(out) in (".node", ".ele"):
             outputs += [os.path.splitext(out)[0] + ".node", os.path.splitext(out)[0] + ".ele"]
+    return outputs
+
+
+def _supervised_mesh(args):
+    """``mesh`` in a supervised child process (--timeout, --max-memory: supervisor.py)."""
+    from .supervisor import Limits, run_supervised
+
+    _check_mesh_args(args)
     limits = Limits(timeout=args.timeout, max_memory=args.max_memory_bytes)
-    return run_supervised(lambda: _run_reporting(_cmd_mesh, args), limits, outputs)
+    return run_supervised(lambda: _run_reporting(_cmd_mesh, args), limits, _mesh_outputs(args))
+
+
+def _interruptible_mesh(args):
+    """``mesh`` in this process; Ctrl-C stops it at once and leaves no partial file."""
+    from .supervisor import run_interruptible
+
+    _check_mesh_args(args)
+    return run_interruptible(lambda: _run_reporting(_cmd_mesh, args), _mesh_outputs(args))
 
 
 def main(argv=None, supervise=True):
-    """The command line. ``supervise=False`` runs ``mesh`` in this process (no --timeout, no
-    memory watch, no crash isolation; for callers that supervise it themselves)."""
+    """The command line. ``mesh`` runs in this process, stopped at once by Ctrl-C; with
+    ``--timeout`` or ``--max-memory`` it runs in a supervised child process that enforces them.
+    ``supervise=False`` runs ``mesh`` in this process with no signal handling and no limits
+    (for callers that supervise it themselves)."""
     args = build_parser().parse_args(argv)
     args.raw_argv = list(sys.argv[1:] if argv is None else argv)
     if args.command == "mesh" and supervise:
-        return _run_reporting(_supervised_mesh, args)
+        limited = args.timeout is not None or args.max_memory is not None
+        return _run_reporting(_supervised_mesh if limited else _interruptible_mesh, args)
     if args.command == "mesh" and args.timeout is not None:
         print("fembsptet: error: --timeout needs the supervised run", file=sys.stderr)
         return 2

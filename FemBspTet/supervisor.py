@@ -1,5 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Runs a meshing job in a child process that can always be stopped within a fraction of a second.
+"""Runs a meshing job so that it can always be stopped within a fraction of a second: in a child
+process when a time or memory limit asks for one (:func:`run_supervised`), else in this process
+(:func:`run_interruptible`: Ctrl-C and SIGTERM only).
 
     from FemBspTet.supervisor import Limits, run_supervised
     code = run_supervised(job, Limits(timeout=60, max_memory=4 << 30), outputs=["out.vtu"])
@@ -29,12 +31,14 @@ import os
 import shutil
 import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass
 
 from .errors import Cancelled, InternalError, MemoryBudgetError, TimeLimitReached
 
-__all__ = ["Limits", "run_supervised", "child_rss_bytes", "remove_temporaries"]
+__all__ = ["Limits", "run_supervised", "run_interruptible", "child_rss_bytes",
+           "remove_temporaries"]
 
 
 @dataclass(frozen=True)
@@ -169,6 +173,9 @@ def run_supervised(job, limits=Limits(), outputs=()):
     if reason is None and os.WIFEXITED(status):
         return os.WEXITSTATUS(status)
     remove_temporaries(outputs, pid)
+    if sys.stderr.isatty():  # the child's progress bar: cursor shown again, its line cleared
+        sys.stderr.write("\x1b[?25h\r\x1b[2K")
+        sys.stderr.flush()
     if reason == "timeout":
         raise TimeLimitReached(
             f"stopped: the time limit of {limits.timeout:g} s (--timeout) was reached; "
@@ -190,3 +197,52 @@ def run_supervised(job, limits=Limits(), outputs=()):
     raise InternalError(
         f"internal error: the mesher crashed ({name}); no output was written. "
         "Please report it with the input")
+
+
+def run_interruptible(job, outputs=()):
+    """Runs ``job()`` in this process (no limits asked for: no child process) and returns its
+    exit code; SIGINT (Ctrl-C) or SIGTERM end the process within a fraction of a second: the
+    temporary files next to ``outputs`` are removed, one message is printed, exit code 130.
+
+    The native core runs without Python's GIL, so a watcher thread can act while it works: the
+    signal's C handler writes to a wakeup pipe (``signal.set_wakeup_fd``) whatever the main
+    thread is doing, and the watcher ends the process there. Outputs are only ever renamed into
+    place complete, so a target keeps its previous content or gets the complete new one.
+    Call from the main thread.
+    """
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(write_fd, False)
+    start = time.monotonic()
+
+    def watch():
+        try:
+            data = os.read(read_fd, 1)
+        except OSError:
+            return
+        if not data:  # the job ended: the pipe was closed
+            return
+        remove_temporaries(outputs, os.getpid())
+        try:
+            name = signal.Signals(data[0]).name
+        except ValueError:
+            name = f"signal {data[0]}"
+        lead = "\x1b[?25h\r\x1b[2K" if sys.stderr.isatty() else ""  # over the progress bar
+        os.write(sys.stderr.fileno(), (f"{lead}fembsptet: interrupted ({name}) after "
+                                       f"{time.monotonic() - start:.1f} s; no output was "
+                                       "written\n").encode())
+        os._exit(130)
+
+    watcher = threading.Thread(target=watch, name="fembsptet-interrupt", daemon=True)
+    watcher.start()
+    old_int = signal.signal(signal.SIGINT, lambda signum, frame: None)
+    old_term = signal.signal(signal.SIGTERM, lambda signum, frame: None)
+    old_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    try:
+        return job()
+    finally:
+        signal.set_wakeup_fd(old_fd)
+        signal.signal(signal.SIGINT, old_int)
+        signal.signal(signal.SIGTERM, old_term)
+        os.close(write_fd)
+        watcher.join()
+        os.close(read_fd)

@@ -12,7 +12,7 @@ PACKAGES=(
   # tests
   libgtest-dev libgmock-dev python3-pytest
   # Python side
-  python3-numpy python3-meshio python3-matplotlib
+  python3-numpy python3-meshio python3-matplotlib python3-rich
   # FreeCAD FEM and the peers we compare with or solve with
   freecad-python3 gmsh python3-gmsh tetgen calculix-ccx python3-netgen
   # the CAD layer (cpp_module/src/cad): OpenCASCADE's headers and libraries

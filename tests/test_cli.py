@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The `fembsptet` command line, run as a user runs it: through bin/fembsptet."""
 
+import io
 import json
 import os
+import re
 import subprocess
 
 import pytest
@@ -10,6 +12,9 @@ from conftest import paper_path
 
 from FemBspTet.mesh_types import TetMesh
 from FemBspTet.volume_io import write_tet_mesh
+
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def run(cli, *args):
@@ -110,7 +115,8 @@ def test_mesh_second_order_is_valid(cli, tmp_path):
 
 
 def test_mesh_prints_stats_and_tetgen_table(cli, tmp_path):
-    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "s.vtu", "--compare-tetgen")
+    r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "s.vtu", "--compare-tetgen",
+            "--json")
     assert r.returncode == 0, r.stderr
     head, _, table = r.stdout.partition("}\n")
     stats = json.loads(head + "}")
@@ -181,9 +187,15 @@ def test_stats_keys_are_documented():
     }
 
 
-def test_progress_bar_is_silent_for_short_runs_and_draws_for_long_ones():
-    import io
+class FakeTerminal(io.StringIO):
+    def isatty(self):
+        return True
 
+
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+
+
+def test_progress_is_silent_for_short_runs_and_plain_lines_off_a_terminal():
     from FemBspTet.progress import Progress
 
     buf = io.StringIO()
@@ -191,13 +203,64 @@ def test_progress_bar_is_silent_for_short_runs_and_draws_for_long_ones():
     p("stage", 0.5)
     assert buf.getvalue() == ""
     p = Progress(stream=buf, delay=0.0)
-    p("reading", 0.25)
+    for stage, fraction in [("reading", 0.25), ("reading", 0.5), ("meshing", None),
+                            ("meshing", 0.9), ("writing", 1.0)]:
+        p(stage, fraction)
+    p.note("a message")
     p.finish()
-    assert "reading" in buf.getvalue() and "25%" in buf.getvalue()
+    lines = buf.getvalue().splitlines()
+    assert [ln.split(" (")[0] for ln in lines] == ["fembsptet: reading", "fembsptet: meshing",
+                                                  "fembsptet: writing", "a message"]
+    assert "\r" not in buf.getvalue() and "\x1b" not in buf.getvalue()
     quiet = io.StringIO()
     p = Progress(enabled=False, stream=quiet, delay=0.0)
     p("x", 1.0)
     assert quiet.getvalue() == ""
+
+
+def test_progress_on_an_80_column_terminal_fits_and_never_goes_back(monkeypatch):
+    from FemBspTet.progress import Progress
+
+    monkeypatch.setenv("COLUMNS", "80")
+    monkeypatch.setenv("TERM", "xterm")
+    term = FakeTerminal()
+    p = Progress(stream=term, delay=0.0)
+    shown = []
+    for stage, fraction in [("a long stage name that is longer than forty characters", 0.3),
+                            ("a long stage name that is longer than forty characters", 0.1),
+                            ("next", 0.5), ("next", 0.93), ("next", 0.2)]:
+        p(stage, fraction)
+        p._live.refresh()
+        shown.append(p._live.tasks[0].percentage)
+    p.note("a message on its own line")
+    p.finish()
+    assert shown == [30.0, 30.0, 50.0, 93.0, 93.0]  # monotone within a stage
+    text = ANSI.sub("", term.getvalue())
+    rows = [row for line in text.split("\n") for row in line.split("\r")]
+    assert max(len(row) for row in rows) <= 80
+    assert any(row.strip() == "a message on its own line" for row in rows)
+    assert any("fembsptet next" in row and "93%" in row for row in rows)
+
+
+def test_mesh_with_stderr_redirected_writes_plain_lines_and_a_summary(cli, tmp_path):
+    err = tmp_path / "err.txt"
+    out = tmp_path / "o.inp"
+    with open(err, "w") as f:
+        r = subprocess.run([cli, "mesh", os.path.join(ROOT, "tests", "data", "cad", "bracket.step"),
+                            "--order", "2", "-o", out], stdout=subprocess.PIPE, stderr=f,
+                           text=True, timeout=300)
+    assert r.returncode == 0
+    text = err.read_text()
+    assert "\r" not in text and "\x1b" not in text
+    assert all(line.startswith("fembsptet: ") for line in text.splitlines())
+    summary = r.stdout.splitlines()
+    assert summary[0].startswith("read ") and "1 solid(s), 13 CAD faces" in summary[0]
+    from FemBspTet.volume_io import read_tet_mesh
+
+    mesh = read_tet_mesh(out)
+    assert summary[1] == (f"wrote    {out}: {len(mesh.points):,} nodes, {len(mesh.tets):,} tet10 "
+                          "elements; sets: 13 CAD face(s), 1 solid(s)")
+    assert summary[2].startswith("quality  worst dihedral ") and summary[3].startswith("time ")
 
 
 @pytest.mark.parametrize("cad", ["tests/data/cad/red_cube_blue_cylinder.step", "resources/samples/bracket.step"])
