@@ -9,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "bsptet/cad/cad_distance.h"
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/errors.h"
 #include "bsptet/fem/fem_mesh.h"
@@ -587,6 +588,33 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("cancel") = py::none(),
       (std::string("A shape in OpenCASCADE's BREP text (FreeCAD's Shape.exportBrepToString()). ") + mesh_cad_doc)
           .c_str());
+
+  m.def(
+      "cad_face_distances",
+      [](const std::string& path, py::array_t<double, py::array::c_style | py::array::forcecast> points,
+         py::array_t<int, py::array::c_style | py::array::forcecast> faces) {
+        if (points.ndim() != 2 || points.shape(1) != 3)
+          throw InputError(ErrorCode::kBadArgument, "cad_distance", -1, "points must have shape (n, 3)");
+        const auto n = static_cast<std::size_t>(points.shape(0));
+        std::vector<Vec3> pts(n);
+        const double* p = points.data();
+        for (std::size_t i = 0; i < n; ++i) pts[i] = Vec3{p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+        std::vector<int> fs(faces.data(), faces.data() + faces.size());
+        cad::FaceDistances d;
+        {
+          const cad::CadModel model = cad::read_cad_file(path);
+          py::gil_scoped_release release;
+          d = cad::distances_to_faces(model, pts, fs);
+        }
+        return py::make_tuple(py::array_t<double>(static_cast<py::ssize_t>(n), d.distance.data()),
+                              py::array_t<int>(static_cast<py::ssize_t>(n), d.face.data()),
+                              py::array_t<double>(static_cast<py::ssize_t>(d.face_tolerance.size()),
+                                                  d.face_tolerance.data()));
+      },
+      py::arg("path"), py::arg("points"), py::arg("faces"),
+      "Distances from points (n, 3) to the faces of the CAD file's model (cad/cad_distance.h): faces (n,) "
+      "0-based, -1 for the nearest face, or empty for all nearest. Returns (distance (n,), face (n,), "
+      "face_tolerance (faces of the model,)).");
 
   m.def(
       "orient3d",
