@@ -496,6 +496,17 @@ def _check_against_cad(args):
     return 0 if ok else 2
 
 
+def _cmd_freecad_install(args):
+    from .addon_install import install
+
+    for line in install(args.mod_dir, uninstall=args.uninstall):
+        print(f"fembsptet: {line}")
+    if not args.uninstall:
+        print("fembsptet: restart FreeCAD; the mesher is in the FEM workbench's Mesh menu and "
+              "toolbar")
+    return 0
+
+
 def _positive_option(value, option):
     if value is not None and not (value > 0 and math.isfinite(value)):
         raise InputError(f"{option} must be a positive number, got {value}")
@@ -640,6 +651,14 @@ def build_parser():
     c.add_argument("--json", action="store_true", help="print the full report as JSON")
     c.add_argument("--max-messages", type=int, default=20, help="problems listed (default 20)")
     c.set_defaults(func=_cmd_check)
+
+    f = sub.add_parser("freecad-install",
+                       help="link this FemBspTet into FreeCAD's user Mod folders (FreeCAD 0.20 "
+                            "to 1.0: ~/.local/share/FreeCAD/Mod; 1.1+: its versioned folders)")
+    f.add_argument("--mod-dir", action="append", default=None, metavar="DIR",
+                   help="link into this Mod folder instead (repeatable)")
+    f.add_argument("--uninstall", action="store_true", help="remove the links instead")
+    f.set_defaults(func=_cmd_freecad_install)
 
     from .compare.process import DEFAULT_TIMEOUT
 

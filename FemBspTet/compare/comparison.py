@@ -247,11 +247,16 @@ def _run_ours(surfaces, size, timeout, workdir, python, options=None):
 
 
 def core_tool_path():
-    """``bsptet_mesh``, the core's command-line program built by scripts/setup.sh, or None."""
+    """``bsptet_mesh``, the core's command-line program, or None: ``$FEMBSPTET_CORE_TOOL``, else
+    the checkout's build (scripts/setup.sh), else an installed addon's ``libexec``."""
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    path = os.environ.get("FEMBSPTET_CORE_TOOL") or os.path.join(root, "build", "cpp_module",
-                                                                 "bsptet_mesh")
-    return path if os.path.isfile(path) and os.access(path, os.X_OK) else None
+    candidates = [os.environ.get("FEMBSPTET_CORE_TOOL")] if os.environ.get(
+        "FEMBSPTET_CORE_TOOL") else [os.path.join(root, "build", "cpp_module", "bsptet_mesh"),
+                                     os.path.join(root, "libexec", "bsptet_mesh")]
+    for path in candidates:
+        if os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
+    return None
 
 
 def _run_ours_native(surfaces, timeout, workdir):
