@@ -496,6 +496,21 @@ def _check_against_cad(args):
     return 0 if ok else 2
 
 
+def _cmd_render(args):
+    from .render import render_mesh
+
+    if _ext(args.output) != ".png":
+        raise InputError("the picture is written as PNG: name it FILE.png", where=args.output)
+    parent = os.path.dirname(os.path.abspath(args.output))
+    if not os.path.isdir(parent):
+        raise InputError("the output directory does not exist", where=parent)
+    mesh = read_volume(args.tetmesh)
+    drawn = render_mesh(mesh, args.output, cut=args.cut, size_px=args.size)
+    print(f"fembsptet: wrote {args.output} ({drawn['triangles']:,} triangles of "
+          f"{drawn['tets']:,} tets drawn)")
+    return 0
+
+
 def _cmd_freecad_install(args):
     from .addon_install import install
 
@@ -651,6 +666,15 @@ def build_parser():
     c.add_argument("--json", action="store_true", help="print the full report as JSON")
     c.add_argument("--max-messages", type=int, default=20, help="problems listed (default 20)")
     c.set_defaults(func=_cmd_check)
+
+    r = sub.add_parser("render", help="a picture of a tet mesh (PNG): the boundary coloured by CAD "
+                                      "face, or --cut through the middle coloured by quality")
+    r.add_argument("tetmesh", help="the tet mesh (.vtu .msh .inp .node/.ele .mesh .unv .med .z88)")
+    r.add_argument("-o", "--output", required=True, metavar="FILE.png")
+    r.add_argument("--cut", action="store_true",
+                   help="remove the near half and colour the tets by their smallest dihedral angle")
+    r.add_argument("--size", type=int, default=900, metavar="PIXELS", help="width and height")
+    r.set_defaults(func=_cmd_render)
 
     f = sub.add_parser("freecad-install",
                        help="link this FemBspTet into FreeCAD's user Mod folders (FreeCAD 0.20 "

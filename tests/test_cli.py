@@ -419,3 +419,29 @@ def test_inp_output_refused_when_its_rounding_would_flatten_a_tet(tmp_path):
         write_output(str(tmp_path / "bad.inp"), mesh)
     assert "bad.inp" in str(exc.value) and "20 characters" in str(exc.value)
     assert not (tmp_path / "bad.inp").exists()
+
+
+def test_render_draws_the_boundary_and_a_cut_coloured_by_quality(cli, tmp_path):
+    import matplotlib.image
+
+    from FemBspTet.fem.cad_mesh import mesh_cad_file
+    from FemBspTet.render import render_mesh
+
+    result = mesh_cad_file(os.path.join(ROOT, "tests", "data", "cad", "bracket.step"), order=2)
+    mesh_file = tmp_path / "b.msh"
+    write_tet_mesh(str(mesh_file), result.mesh, result.groups)
+    for extra, name in (([], "b.png"), (["--cut"], "c.png")):
+        r = run(cli, "render", mesh_file, "-o", tmp_path / name, "--size", "400", *extra)
+        assert r.returncode == 0, r.stderr
+        image = matplotlib.image.imread(str(tmp_path / name))
+        assert image.shape[:2] == (400, 400)
+        assert (image[:, :, :3] < 0.95).any()  # something was drawn on the white page
+    assert "of 5," in run(cli, "render", mesh_file, "-o", tmp_path / "d.png").stdout
+    # a sliver shows red in the cut view
+    sliver = TetMesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.5, 0.5, 0.01]], [[0, 1, 2, 3]])
+    drawn = render_mesh(sliver, tmp_path / "s.png", cut=True, size_px=300)
+    assert drawn["tets"] == 1
+    rgb = matplotlib.image.imread(str(tmp_path / "s.png"))[:, :, :3]
+    assert ((rgb[:, :, 0] > 0.45) & (rgb[:, :, 1] < 0.25) & (rgb[:, :, 2] < 0.25)).any()
+    r = run(cli, "render", mesh_file, "-o", tmp_path / "x.jpg")
+    assert r.returncode == 2 and "PNG" in r.stderr

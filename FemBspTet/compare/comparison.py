@@ -527,7 +527,7 @@ def plot_histograms(path, result: Comparison):
 
     rows = [r for r in result.rows if r.status == "ok"]
     fig, axes = plt.subplots(1, max(len(rows), 1), figsize=(3.2 * max(len(rows), 1), 2.6),
-                             sharey=True, squeeze=False)
+                             squeeze=False)  # each panel its own scale: both stay readable
     for ax, r in zip(axes[0], rows):
         h = np.asarray(r.dihedral_histogram, float)
         ax.bar(np.arange(180) + 0.5, h / max(h.sum(), 1), width=1.0,
