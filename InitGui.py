@@ -2,7 +2,7 @@
 # FemBspTet: FreeCAD start-up (GUI side). exec()'d by FreeCAD inside a function: no __file__, and
 # top-level names are locals, so everything the workbench needs is imported inside its methods.
 # At start-up: the command FEM_MeshBspTetFromShape is registered, put into FEM's toolbar and menu
-# (FemBspTet/commands.py), and the preferences page is added (Edit > Preferences > FEM).
+# (FemBspTet/gui/commands.py), and the preferences page is added (Edit > Preferences > FEM).
 import FreeCADGui
 
 
@@ -13,7 +13,7 @@ class FemBspTetWorkbench(FreeCADGui.Workbench):
     ToolTip = "BSP-assisted constrained tetrahedralization for FEM"
 
     def __init__(self):
-        from FemBspTet import commands
+        from FemBspTet.gui import commands
 
         self.__class__.Icon = commands.workbench_icon_path()
         self.keep_alive = []  # the FEM toolbar/menu helpers live as long as the workbench
@@ -37,7 +37,7 @@ class FemBspTetWorkbench(FreeCADGui.Workbench):
             FreeCAD.Console.PrintWarning("FemBspTet: no preferences page: %s\n" % e)
 
     def Initialize(self):
-        from FemBspTet import commands
+        from FemBspTet.gui import commands
 
         self.appendToolbar("BspTet", [commands.COMMAND_NAME])
         self.appendMenu("&BspTet", [commands.COMMAND_NAME])

@@ -44,7 +44,7 @@ def main(argv=None):
                            repeats=args.repeats)
     print(text[text.index("## Ratios"):])
     if args.markdown:
-        from FemBspTet.atomic_file import atomic_output
+        from FemBspTet.io.atomic_file import atomic_output
 
         with atomic_output(args.markdown) as f:
             f.write(text)

@@ -19,12 +19,12 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from FemBspTet.cad_tessellation import CAD_FORMATS  # noqa: E402
+from FemBspTet.io.cad_tessellation import CAD_FORMATS  # noqa: E402
 from FemBspTet.compare.benchmark import model_paths  # noqa: E402
-from FemBspTet.errors import BspTetError  # noqa: E402
-from FemBspTet.freecad_env import import_freecad  # noqa: E402
-from FemBspTet.mesh_pipeline import MeshParameters  # noqa: E402
-from FemBspTet.mesh_worker import MeshJob  # noqa: E402
+from FemBspTet.kernel.errors import BspTetError  # noqa: E402
+from FemBspTet.kernel.freecad_env import import_freecad  # noqa: E402
+from FemBspTet.fem.mesh_pipeline import MeshParameters  # noqa: E402
+from FemBspTet.freecad.mesh_worker import MeshJob  # noqa: E402
 
 
 def main():

@@ -3,7 +3,7 @@
 """The CalculiX acceptance cases of the FreeCAD mesher, with figures: each case solved with our
 mesh and with FreeCAD's Gmsh mesh at the same CharacteristicLengthMax, tet4 and tet10, and the
 ratio of the maximum displacements. Usage: bench/freecad_calculix.py [CASE ...]
-(cases: cantilever, plate_with_hole; see FemBspTet/compare/calculix_cases.py).
+(cases: cantilever, plate_with_hole; see FemBspTet/freecad/calculix_cases.py).
 """
 
 import os
@@ -13,9 +13,9 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from FemBspTet.compare import calculix_cases as cc  # noqa: E402
-from FemBspTet.errors import BspTetError  # noqa: E402
-from FemBspTet.freecad_env import import_freecad  # noqa: E402
+from FemBspTet.freecad import calculix_cases as cc  # noqa: E402
+from FemBspTet.kernel.errors import BspTetError  # noqa: E402
+from FemBspTet.kernel.freecad_env import import_freecad  # noqa: E402
 
 
 def main():

@@ -10,7 +10,7 @@
 
 The surfaces are the scaling benchmark's (bench/scaling.py: a cube-sphere, a torus, the OCCT
 bottle tessellated by FreeCAD), or the OFF files of --inputs. Each run is a process of its own,
-timed by ``FemBspTet.compare.process.run_measured`` (wall time, peak RSS from GNU time):
+timed by ``FemBspTet.peers.process.run_measured`` (wall time, peak RSS from GNU time):
 
 * ``ours``: ``bsptet_mesh FILE.off --no-check --write STEM`` (the core in memory);
 * ``pieces``: ``bsptet_mesh FILE.off --max-memory B --no-check --write STEM`` for each budget B:
@@ -41,13 +41,13 @@ _PIECES = re.compile(r"pieces (\d+) \(largest (\d+) triangles, at most (\d+)\) c
 
 
 def parse_size(text):
-    from FemBspTet.memory_budget import parse_size as parse
+    from FemBspTet.kernel.memory_budget import parse_size as parse
 
     return parse(text, option="--budgets")
 
 
 def run_ours(binary, off, stem, timeout, budget=None):
-    from FemBspTet.compare.process import run_measured
+    from FemBspTet.peers.process import run_measured
 
     command = [binary, off, "--no-check", "--write", stem]
     if budget is not None:
@@ -70,7 +70,7 @@ def run_ours(binary, off, stem, timeout, budget=None):
 
 
 def run_tetgen(off, workdir, timeout):
-    from FemBspTet.compare.process import run_measured
+    from FemBspTet.peers.process import run_measured
 
     local = os.path.join(workdir, "tetgen_input.off")
     with open(off, encoding="ascii") as src, open(local, "w", encoding="ascii") as dst:
@@ -87,8 +87,8 @@ def run_tetgen(off, workdir, timeout):
 
 
 def check(surface, stem):
-    from FemBspTet import core
-    from FemBspTet.volume_io import read_tetgen
+    from FemBspTet.kernel import core
+    from FemBspTet.io.volume_io import read_tetgen
 
     mesh = read_tetgen(stem)
     report = core.check_mesh(surface, mesh, max_messages=3, compute_quality=False)
@@ -112,7 +112,7 @@ def main(argv=None):
     command = "bench/out_of_core.py " + shlex.join(sys.argv[1:] if argv is None else argv)
     meshers = [m for m in args.meshers.split(",") if m]
     budgets = [(b, parse_size(b)) for b in args.budgets.split(",") if b]
-    from FemBspTet.surface_io import read_surface, write_surface
+    from FemBspTet.io.surface_io import read_surface, write_surface
 
     workdir = args.keep or tempfile.mkdtemp(prefix="fembsptet_ooc_")
     os.makedirs(workdir, exist_ok=True)
@@ -176,7 +176,7 @@ def main(argv=None):
     heads, body = _table(rows)
     print(_text(heads, body))
     if args.markdown:
-        from FemBspTet.atomic_file import atomic_output
+        from FemBspTet.io.atomic_file import atomic_output
 
         with atomic_output(args.markdown) as f:
             f.write("# Out-of-core mode against the in-memory core and TetGen\n\n")

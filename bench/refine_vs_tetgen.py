@@ -32,7 +32,7 @@ sys.path.insert(0, ROOT)
 import numpy as np  # noqa: E402
 
 from FemBspTet.compare.comparison import OURS, TETGEN_PQ, compare  # noqa: E402
-from FemBspTet.surface_io import read_surface  # noqa: E402
+from FemBspTet.io.surface_io import read_surface  # noqa: E402
 
 
 def _models(args):

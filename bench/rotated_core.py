@@ -33,7 +33,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from FemBspTet.surface_io import read_surface  # noqa: E402
+from FemBspTet.io.surface_io import read_surface  # noqa: E402
 
 DEFAULT_MODELS = ("thingi10k_1514499", "no_print_feeder_body", "hinge", "pinion", "anchor")
 ROTATION_SEEDS = (1, 2, 3)
@@ -141,7 +141,7 @@ def main(argv=None):
         command.append(f"--timeout {args.timeout:g}")
     text = report(rows, " ".join(command))
     if args.markdown:
-        from FemBspTet.atomic_file import atomic_output
+        from FemBspTet.io.atomic_file import atomic_output
 
         with atomic_output(args.markdown) as f:
             f.write(text)

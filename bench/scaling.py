@@ -24,7 +24,7 @@ surface check (no duplicate point, no degenerate triangle, closed, oriented, no
 self-intersection) before any mesher runs.
 
 Each mesher runs as a process of its own, one at a time, measured by
-``FemBspTet.compare.process.run_measured`` (wall time of the process, start-up included; peak
+``FemBspTet.peers.process.run_measured`` (wall time of the process, start-up included; peak
 RSS from GNU time): ``ours`` is the comparison's worker (``python3 -m
 FemBspTet.compare.ours_worker``: core.tetrahedralize, which checks its mesh exactly before
 returning, and writes a VTU) or, with ``--ours binary``, ``bsptet_mesh FILE.off --no-check
@@ -178,7 +178,7 @@ def edge_defects(triangles):
 
 def make_surface(family, target, cad_file=DEFAULT_CAD_FILE, log=None):
     """The ``family`` surface with about ``target`` triangles: ``(Surface, note)``."""
-    from FemBspTet.mesh_types import Surface
+    from FemBspTet.kernel.mesh_types import Surface
 
     if family == "sphere":
         n = cube_sphere_n(target)
@@ -196,7 +196,7 @@ def make_surface(family, target, cad_file=DEFAULT_CAD_FILE, log=None):
 def freecad_problem():
     """None when FreeCAD loads in this interpreter, else why not."""
     try:
-        from FemBspTet.freecad_env import import_freecad
+        from FemBspTet.kernel.freecad_env import import_freecad
 
         import_freecad()
         import Part  # noqa: F401
@@ -212,10 +212,10 @@ def cad_surface(target, path=DEFAULT_CAD_FILE, log=None, tolerance=0.15, tries=8
     """The CAD part ``path`` tessellated by FemBspTet (``tessellate_shape``) with the linear
     deflection that gives about ``target`` triangles (count ~ deflection^-a, a fitted as we
     go). Returns ``(Surface, note)``; a solid of several solids is joined into one surface."""
-    from FemBspTet.cad_tessellation import default_linear_deflection, surfaces_to_single, \
+    from FemBspTet.io.cad_tessellation import default_linear_deflection, surfaces_to_single, \
         tessellate_shape
-    from FemBspTet.errors import InputError
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.errors import InputError
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     import_freecad()
     import Part
@@ -278,8 +278,8 @@ def run_mesher(mesher, surface, off_path, timeout, workdir, ours="worker", binar
     """One measured run: a dict with status ("ok", "failed", "timeout"), message, seconds,
     peak_mb, tets, nodes, valid (None when not checked), core_seconds (ours, binary only)."""
     from FemBspTet.compare.comparison import MesherFailed, _run_ours, _run_tetgen, evaluate
-    from FemBspTet.compare.process import run_measured
-    from FemBspTet.errors import BspTetError
+    from FemBspTet.peers.process import run_measured
+    from FemBspTet.kernel.errors import BspTetError
 
     out = {"mesher": mesher, "status": "ok", "message": "", "seconds": None, "peak_mb": None,
            "tets": None, "nodes": None, "valid": None, "core_seconds": None,
@@ -304,7 +304,7 @@ def run_mesher(mesher, surface, off_path, timeout, workdir, ours="worker", binar
             out["core_seconds"] = float(m.group(4))
             out["cpu_seconds"] = _children_cpu() - before
             if check:
-                from FemBspTet.volume_io import read_tetgen
+                from FemBspTet.io.volume_io import read_tetgen
 
                 out["valid"] = bool(evaluate([surface], [read_tetgen(stem)])["valid"])
             return out
@@ -461,7 +461,7 @@ def plot(path, rows, families, timeout):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from FemBspTet.atomic_file import atomic_output
+    from FemBspTet.io.atomic_file import atomic_output
 
     colors = {OURS: "tab:blue", TETGEN_PY: "tab:red", TETGEN_PQ: "tab:orange"}
     styles = {"sphere": ("-", "o"), "torus": ("--", "s"), "cad": (":", "^")}
@@ -593,9 +593,9 @@ def main(argv=None):
     own = args.keep is None
     workdir = tempfile.mkdtemp(prefix="fembsptet_scaling_") if own else args.keep
     os.makedirs(workdir, exist_ok=True)
-    from FemBspTet import core
-    from FemBspTet.errors import BspTetError
-    from FemBspTet.surface_io import read_surface, write_surface
+    from FemBspTet.kernel import core
+    from FemBspTet.kernel.errors import BspTetError
+    from FemBspTet.io.surface_io import read_surface, write_surface
 
     inputs, rows = [], []
     stopped = set()  # (family, mesher) that timed out: not run on larger sizes
@@ -681,7 +681,7 @@ def write_outputs(args, command, families, meshers, inputs, rows, notes, elapsed
     print("growth exponents (least-squares slope on log-log over the finished sizes):")
     print(text_table(eh, eb))
 
-    from FemBspTet.atomic_file import atomic_output
+    from FemBspTet.io.atomic_file import atomic_output
 
     if args.json:
         with atomic_output(args.json) as f:

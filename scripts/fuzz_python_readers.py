@@ -36,10 +36,10 @@ sys.path.insert(0, ROOT)
 
 import numpy as np  # noqa: E402
 
-from FemBspTet.errors import InputError  # noqa: E402
-from FemBspTet.mesh_types import Surface, TetMesh  # noqa: E402
-from FemBspTet.surface_io import read_surface, write_surface  # noqa: E402
-from FemBspTet.volume_io import read_tet_mesh, write_tet_mesh  # noqa: E402
+from FemBspTet.kernel.errors import InputError  # noqa: E402
+from FemBspTet.kernel.mesh_types import Surface, TetMesh  # noqa: E402
+from FemBspTet.io.surface_io import read_surface, write_surface  # noqa: E402
+from FemBspTet.io.volume_io import read_tet_mesh, write_tet_mesh  # noqa: E402
 
 SURFACE_EXT = (".off", ".stl", ".obj", ".ply")
 VOLUME_EXT = (".vtu", ".msh", ".inp", ".node", ".ele", ".mesh")
@@ -87,7 +87,7 @@ def make_seeds(folder):
         seeds += [(base + e, "surface") for e in (".obj", ".ply", ".stl", "_ascii.stl", "_bin.ply")]
     pts = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1)], dtype=float)
     mesh = TetMesh(pts, np.array([(0, 1, 2, 3), (1, 2, 3, 4)]))
-    from FemBspTet.core import to_second_order
+    from FemBspTet.kernel.core import to_second_order
 
     for order, m in ((1, mesh), (2, to_second_order(mesh))):
         for ext in (".vtu", ".msh", ".inp", ".node", ".mesh"):

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from FemBspTet.mesh_types import Surface
+from FemBspTet.kernel.mesh_types import Surface
 
 
 def icosphere(radius=1.0, subdivisions=1):

@@ -34,8 +34,8 @@ def cli():
 def tetgen_meshes():
     """TetGen -pY meshes of the paper polyhedra: {name: (surface, mesh)}. TetGen is a declared
     dependency (scripts/setup.sh installs it), so its absence is a failure, not a skip."""
-    from FemBspTet.compare.tetgen_backend import run_tetgen, tetgen_available
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.peers.tetgen import run_tetgen, tetgen_available
+    from FemBspTet.io.surface_io import read_surface
 
     assert tetgen_available(), "tetgen is missing: run scripts/setup.sh"
     out = {}
@@ -50,7 +50,7 @@ def fc():
     """(FreeCAD, Part, Fem), FreeCAD bootstrapped headless (freecad_env). Test modules that need
     FreeCAD skip themselves first when it is missing; test_cad_tessellation has its own (FreeCAD,
     Part) variant."""
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     freecad = import_freecad()
     import Fem

@@ -46,7 +46,7 @@ try:
                 for t in mw.findChildren(QtGui.QToolBar)}
         facts["fem_toolbars"] = sorted(bars)
         facts["bsptet_toolbar_in_fem"] = bars.get("BspTet")
-        from FemBspTet import commands
+        from FemBspTet.gui import commands
 
         for _ in range(5):
             QtGui.QApplication.processEvents()
@@ -76,7 +76,7 @@ try:
     def _():
         FreeCADGui.Selection.clearSelection()
         FreeCADGui.Selection.addSelection(block)
-        from FemBspTet.commands import CommandMeshBspTetFromShape
+        from FemBspTet.gui.commands import CommandMeshBspTetFromShape
 
         facts["command_active_with_selection"] = CommandMeshBspTetFromShape().IsActive()
         FreeCADGui.Selection.clearSelection()
@@ -99,7 +99,7 @@ try:
 
     @step("task panel meshes")
     def _():
-        from FemBspTet.task_panel import TaskPanelMeshBspTet
+        from FemBspTet.gui.task_panel import TaskPanelMeshBspTet
 
         obj = state["obj"]
         obj.ElementOrder = "1st"
@@ -187,7 +187,7 @@ try:
         path = os.path.join(tempfile.mkdtemp(prefix="fembsptet_gui_"), "gui_test.FCStd")
         doc.saveAs(path)
         gui_xml = zipfile.ZipFile(path).read("GuiDocument.xml").decode()
-        facts["gui_document_has_vp_module"] = "FemBspTet.view_provider" in gui_xml
+        facts["gui_document_has_vp_module"] = "FemBspTet.gui.view_provider" in gui_xml
         FreeCAD.closeDocument(doc.Name)
         doc2 = FreeCAD.openDocument(path)
         o2 = doc2.getObject("MeshBspTet")

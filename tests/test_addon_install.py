@@ -11,7 +11,7 @@ import subprocess
 import pytest
 
 import FemBspTet
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.freecad_env import freecad_available
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -21,7 +21,7 @@ if not freecad_available():
 
 
 def test_package_xml_passes_freecads_metadata_reader():
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     freecad = import_freecad()
     md = freecad.Metadata(os.path.join(ROOT, "package.xml"))

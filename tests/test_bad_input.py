@@ -20,7 +20,7 @@ import pytest
 from analytic_surfaces import lat_long_sphere
 from conftest import DATA, corpus_path, paper_path
 
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.freecad_env import freecad_available
 
 CUBE_POINTS = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
 CUBE_TRIS = [(0, 2, 1), (1, 2, 3), (4, 5, 6), (5, 7, 6), (0, 1, 4), (1, 5, 4),
@@ -111,7 +111,7 @@ def garbage(tmp):
 
 
 def cad_open_shell(tmp):
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     import_freecad()
     import Part
@@ -277,9 +277,9 @@ def test_reorient_repairs_orientation_and_meshes_validly(cli, tmp_path):
     assert "re-oriented 10 triangle(s)" in r.stderr
     assert json.loads(stats.read_text())["flipped_triangles"] == 10
     # The mesh fills the re-oriented surface: check it against that surface, exactly.
-    from FemBspTet import core
-    from FemBspTet.surface_io import read_surface, write_surface
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.kernel import core
+    from FemBspTet.io.surface_io import read_surface, write_surface
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     fixed, info = core.check_surface(read_surface(corpus_path("td_spike-1-10")), reorient=True)
     assert info["flipped_triangles"] == 10
@@ -300,9 +300,9 @@ def test_reorient_repairs_orientation_and_meshes_validly(cli, tmp_path):
 
 
 def test_write_intersections_writes_the_pairs_triangles(cli, tmp_path):
-    from FemBspTet import core
-    from FemBspTet.errors import SelfIntersectionError
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.kernel import core
+    from FemBspTet.kernel.errors import SelfIntersectionError
+    from FemBspTet.io.surface_io import read_surface
 
     src = tmp_path / "overlap.off"
     src.write_text(off_text(*two_boxes(box(0, 2), box(1, 2, 8))))
@@ -329,9 +329,9 @@ def test_write_intersections_writes_the_pairs_triangles(cli, tmp_path):
 
 
 def test_python_api_raises_typed_errors_with_codes():
-    from FemBspTet import core
-    from FemBspTet.errors import InputError
-    from FemBspTet.mesh_types import Surface
+    from FemBspTet.kernel import core
+    from FemBspTet.kernel.errors import InputError
+    from FemBspTet.kernel.mesh_types import Surface
 
     pts, tris = box()
     cases = {
@@ -389,9 +389,9 @@ def test_ctrl_c_stops_within_a_second_and_writes_nothing(cli, tmp_path, sig):
 
 
 def test_worker_crash_is_reported_and_temporaries_removed(tmp_path):
-    from FemBspTet.atomic_file import atomic_output
-    from FemBspTet.errors import InternalError
-    from FemBspTet.supervisor import Limits, run_supervised
+    from FemBspTet.io.atomic_file import atomic_output
+    from FemBspTet.kernel.errors import InternalError
+    from FemBspTet.cli.supervisor import Limits, run_supervised
 
     target = tmp_path / "out.vtu"
 
@@ -414,8 +414,8 @@ def test_worker_crash_is_reported_and_temporaries_removed(tmp_path):
 
 
 def test_memory_watch_stops_a_run_over_budget(tmp_path):
-    from FemBspTet.errors import MemoryBudgetError
-    from FemBspTet.supervisor import Limits, run_supervised
+    from FemBspTet.kernel.errors import MemoryBudgetError
+    from FemBspTet.cli.supervisor import Limits, run_supervised
 
     def hog():
         block = bytearray(400 << 20)  # 400 MiB, touched
@@ -432,8 +432,8 @@ def test_memory_watch_stops_a_run_over_budget(tmp_path):
 
 
 def test_sizes_and_estimates():
-    from FemBspTet.errors import InputError
-    from FemBspTet.memory_budget import estimate_peak_bytes, parse_size
+    from FemBspTet.kernel.errors import InputError
+    from FemBspTet.kernel.memory_budget import estimate_peak_bytes, parse_size
 
     assert parse_size("4G") == 4 << 30 and parse_size("512M") == 512 << 20
     assert parse_size("1.5GiB") == 3 << 29 and parse_size("1000") == 1000
@@ -459,9 +459,9 @@ def test_pinned_python_fuzz_findings(name):
     and no numpy RuntimeWarning (an invalid cast means a silently wrong value)."""
     import warnings
 
-    from FemBspTet.errors import InputError
-    from FemBspTet.surface_io import read_surface
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.kernel.errors import InputError
+    from FemBspTet.io.surface_io import read_surface
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     path = os.path.join(FUZZ_DIR, name)
     reader = read_surface if os.path.splitext(name)[1] in (".off", ".stl", ".obj", ".ply") \

@@ -10,11 +10,11 @@ import subprocess
 import numpy as np
 import pytest
 
-from FemBspTet.core import boundary_surface
+from FemBspTet.kernel.core import boundary_surface
 from FemBspTet.fem.cad_check import check_against_cad
 from FemBspTet.fem.cad_mesh import mesh_cad_file
-from FemBspTet.mesh_types import TetMesh
-from FemBspTet.volume_io import read_tet_mesh, write_tet_mesh
+from FemBspTet.kernel.mesh_types import TetMesh
+from FemBspTet.io.volume_io import read_tet_mesh, write_tet_mesh
 
 DATA = os.path.join(os.path.dirname(__file__), "data", "cad")
 PART = os.path.join(DATA, "red_cube_blue_cylinder.step")

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Tests of FemBspTet.cad_tessellation (FreeCAD shapes and CAD files -> face-tagged surfaces).
+"""Tests of FemBspTet.io.cad_tessellation (FreeCAD shapes and CAD files -> face-tagged surfaces).
 
 Run with Debian's interpreter from the checkout: ``/usr/bin/python3 -m pytest -q tests``.
 Skipped when FreeCAD (Debian package freecad-python3) is not available. The invariants are
@@ -14,15 +14,15 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from FemBspTet.errors import InputError
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.errors import InputError
+from FemBspTet.kernel.freecad_env import freecad_available
 
 if not freecad_available():
     pytest.skip("FreeCAD (Debian package freecad-python3) is not available in this interpreter",
                 allow_module_level=True)
 
-from FemBspTet import cad_tessellation as ct  # noqa: E402
-from FemBspTet.mesh_types import Surface  # noqa: E402
+from FemBspTet.io import cad_tessellation as ct  # noqa: E402
+from FemBspTet.kernel.mesh_types import Surface  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
 BOTTLE = os.path.join(DATA, "bottle.brep")
@@ -32,7 +32,7 @@ CUBE_CYLINDER = os.path.join(DATA, "red_cube_blue_cylinder.step")
 @pytest.fixture(scope="module")
 def fc():
     """(FreeCAD, Part), bootstrapped once per test process."""
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     freecad = import_freecad()
     import Part
@@ -503,7 +503,7 @@ def test_copied_file_reads_the_same(fc, tmp_path):
 # ---------------------------------------------------------------------------------------------
 
 def test_import_freecad_is_idempotent_and_loads_fem(fc):
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     freecad, _ = fc
     assert import_freecad() is freecad

@@ -11,7 +11,7 @@ import shutil
 
 import pytest
 
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.freecad_env import freecad_available
 
 if not freecad_available():
     pytest.skip("FreeCAD (Debian package freecad-python3) is not available",
@@ -20,12 +20,12 @@ if shutil.which("ccx") is None or shutil.which("gmsh") is None:
     pytest.fail("ccx and gmsh are declared dependencies: run scripts/setup.sh",
                 pytrace=False)
 
-from FemBspTet.compare import calculix_cases as cc  # noqa: E402
+from FemBspTet.freecad import calculix_cases as cc  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def freecad():
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     return import_freecad()
 
@@ -86,7 +86,8 @@ def test_plate_hole_face_nodes_found_and_pressure_solves(freecad, tmp_path_facto
     """tet4 and tet10: every boundary node of the hole's face (mid-nodes included) is found by
     getNodesByFace, CalculiX's face search finds exactly our boundary triangles there, and the
     pressure case solves."""
-    from FemBspTet import mesh_pipeline, mesher_tools
+    from FemBspTet.fem import mesh_pipeline
+    from FemBspTet.freecad import mesher_tools
 
     doc = freecad.newDocument("PlateNodes")
     try:

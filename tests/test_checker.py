@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from conftest import PAPER_MODELS, corpus_path
 
-from FemBspTet import core
-from FemBspTet.mesh_types import Surface, TetMesh
+from FemBspTet.kernel import core
+from FemBspTet.kernel.mesh_types import Surface, TetMesh
 
 DEFECT_KEYS = (
     "inverted_tets", "flat_tets", "overshared_faces", "same_orientation_faces",
@@ -100,8 +100,8 @@ CORPUS_VALID = ("cube", "star", "tinytorus", "joint", "eight", "hinge", "pinion"
 
 @pytest.mark.parametrize("name", CORPUS_VALID)
 def test_accepts_tetgen_on_corpus(name):
-    from FemBspTet.compare.tetgen_backend import run_tetgen
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.peers.tetgen import run_tetgen
+    from FemBspTet.io.surface_io import read_surface
 
     surface = read_surface(corpus_path(name))
     mesh = run_tetgen(surface, "pY").mesh
@@ -113,8 +113,8 @@ def test_accepts_tetgen_on_corpus(name):
 def test_inward_surface_is_rejected():
     """engine_bracket's surface faces inward (manifest: signed volume < 0): TetGen still meshes it,
     but against the surface as given every boundary face is reversed."""
-    from FemBspTet.compare.tetgen_backend import run_tetgen
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.peers.tetgen import run_tetgen
+    from FemBspTet.io.surface_io import read_surface
 
     surface = read_surface(corpus_path("engine_bracket"))
     assert core.signed_volume(surface) < 0
@@ -141,8 +141,8 @@ def test_tet_quality_of_regular_tet():
 def test_filled_internal_void_is_rejected():
     """cray_left has an internal void. TetGen -pY without a hole point fills it, so the void's
     triangles end up inside the mesh, not on its boundary: the checker must say so."""
-    from FemBspTet.compare.tetgen_backend import run_tetgen
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.peers.tetgen import run_tetgen
+    from FemBspTet.io.surface_io import read_surface
 
     surface = read_surface(corpus_path("cray_left"))
     mesh = run_tetgen(surface, "pY").mesh

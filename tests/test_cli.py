@@ -10,8 +10,8 @@ import subprocess
 import pytest
 from conftest import paper_path
 
-from FemBspTet.mesh_types import TetMesh
-from FemBspTet.volume_io import write_tet_mesh
+from FemBspTet.kernel.mesh_types import TetMesh
+from FemBspTet.io.volume_io import write_tet_mesh
 
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -87,7 +87,7 @@ def test_mesh_paper_model_is_valid_and_checked_independently(cli, tmp_path, mode
     assert r.returncode == 0, r.stderr
     assert r.stdout == ""  # --quiet
     stats = json.loads(stats_file.read_text())
-    from FemBspTet.cli import STATS_KEYS
+    from FemBspTet.cli.main import STATS_KEYS
 
     assert set(STATS_KEYS) <= set(stats)
     # The independent check reads the file back: counts must match what the stats claim.
@@ -105,7 +105,7 @@ def test_mesh_second_order_is_valid(cli, tmp_path):
     out = tmp_path / "o2.inp"
     r = run(cli, "mesh", paper_path("box_with_hole"), "-o", out, "--order", "2", "--quiet")
     assert r.returncode == 0, r.stderr
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     mesh = read_tet_mesh(str(out))
     assert mesh.tets.shape[1] == 10
@@ -161,7 +161,7 @@ def test_mesh_bad_input_exit_2(cli, tmp_path):
 
 
 def test_mesh_rejects_open_cad_shell(cli, tmp_path):
-    from FemBspTet.freecad_env import freecad_available, import_freecad
+    from FemBspTet.kernel.freecad_env import freecad_available, import_freecad
 
     if not freecad_available():
         pytest.skip("FreeCAD is not installed")
@@ -178,7 +178,7 @@ def test_mesh_rejects_open_cad_shell(cli, tmp_path):
 
 
 def test_stats_keys_are_documented():
-    from FemBspTet.cli import STATS_KEYS
+    from FemBspTet.cli.main import STATS_KEYS
 
     assert set(STATS_KEYS) >= {
         "input_points", "input_triangles", "points", "tets", "steiner_points",
@@ -196,7 +196,7 @@ ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
 
 def test_progress_is_silent_for_short_runs_and_plain_lines_off_a_terminal():
-    from FemBspTet.progress import Progress
+    from FemBspTet.kernel.progress import Progress
 
     buf = io.StringIO()
     p = Progress(stream=buf, delay=1.0)
@@ -219,7 +219,7 @@ def test_progress_is_silent_for_short_runs_and_plain_lines_off_a_terminal():
 
 
 def test_progress_on_an_80_column_terminal_fits_and_never_goes_back(monkeypatch):
-    from FemBspTet.progress import Progress
+    from FemBspTet.kernel.progress import Progress
 
     monkeypatch.setenv("COLUMNS", "80")
     monkeypatch.setenv("TERM", "xterm")
@@ -255,7 +255,7 @@ def test_mesh_with_stderr_redirected_writes_plain_lines_and_a_summary(cli, tmp_p
     assert all(line.startswith("fembsptet: ") for line in text.splitlines())
     summary = r.stdout.splitlines()
     assert summary[0].startswith("read ") and "1 solid(s), 13 CAD faces" in summary[0]
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     mesh = read_tet_mesh(out)
     assert summary[1] == (f"wrote    {out}: {len(mesh.points):,} nodes, {len(mesh.tets):,} tet10 "
@@ -265,7 +265,7 @@ def test_mesh_with_stderr_redirected_writes_plain_lines_and_a_summary(cli, tmp_p
 
 @pytest.mark.parametrize("cad", ["tests/data/cad/red_cube_blue_cylinder.step", "resources/samples/bracket.step"])
 def test_mesh_cad_solid_is_valid(cli, tmp_path, cad):
-    from FemBspTet.freecad_env import freecad_available
+    from FemBspTet.kernel.freecad_env import freecad_available
 
     if not freecad_available():
         pytest.skip("FreeCAD is not installed")
@@ -276,7 +276,7 @@ def test_mesh_cad_solid_is_valid(cli, tmp_path, cad):
     assert r.returncode == 0, r.stderr
     stats = json.loads(stats_file.read_text())
     # `mesh` checks its mesh exactly before writing; the file must hold what the stats say.
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     mesh = read_tet_mesh(str(out))
     assert stats["valid"] is True and stats["boundary_steiner_points"] == 0
@@ -343,7 +343,7 @@ def _boundary_nodes_off_cad(mesh, shape):
     """Largest distance from a boundary node (corners and tet10 mid-nodes of boundary faces) to
     the CAD shape's faces."""
     import Part
-    from FemBspTet.mesh_pipeline import boundary_faces_of, boundary_midnodes
+    from FemBspTet.fem.mesh_pipeline import boundary_faces_of, boundary_midnodes
 
     faces = boundary_faces_of(mesh.tets[:, :4])
     nodes = set(faces.reshape(-1).tolist())
@@ -363,14 +363,14 @@ def test_mesh_cad_puts_tet10_mid_nodes_on_the_cad(cli, tmp_path):
     """A CAD file is meshed by the FEM path: every boundary node of the tet10 mesh (corners and
     mid-nodes, the cylinder's included) lies on the CAD; ``--tessellation`` fills the display
     tessellation with the core instead, its mid-nodes on the chords of the cylinder."""
-    from FemBspTet.freecad_env import freecad_available, import_freecad
+    from FemBspTet.kernel.freecad_env import freecad_available, import_freecad
 
     if not freecad_available():
         pytest.skip("FreeCAD is not installed")
     import_freecad()
     import Part
 
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     cad = os.path.join(root, "tests", "data", "cad", "red_cube_blue_cylinder.step")
@@ -405,9 +405,9 @@ def test_inp_output_refused_when_its_rounding_would_flatten_a_tet(tmp_path):
     rounded, d lies on the plane z = x through a, b, c and the tet is flat."""
     import numpy as np
 
-    from FemBspTet import core
-    from FemBspTet.cli import write_output
-    from FemBspTet.errors import InputError
+    from FemBspTet.kernel import core
+    from FemBspTet.cli.main import write_output
+    from FemBspTet.kernel.errors import InputError
 
     pts = np.array([[0, 0, 0], [1, 0, 1], [0, 1, 0],
                     [-0.00012345678901234567, 0.5, -0.00012345678901234564]])
@@ -425,7 +425,7 @@ def test_render_draws_the_boundary_and_a_cut_coloured_by_quality(cli, tmp_path):
     import matplotlib.image
 
     from FemBspTet.fem.cad_mesh import mesh_cad_file
-    from FemBspTet.render import render_mesh
+    from FemBspTet.io.render import render_mesh
 
     result = mesh_cad_file(os.path.join(ROOT, "tests", "data", "cad", "bracket.step"), order=2)
     mesh_file = tmp_path / "b.msh"

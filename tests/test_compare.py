@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from conftest import PAPER_MODELS, ROOT, paper_path
 
-from FemBspTet.surface_io import read_surface
-from FemBspTet.volume_io import read_tet_mesh, read_tetgen
+from FemBspTet.io.surface_io import read_surface
+from FemBspTet.io.volume_io import read_tet_mesh, read_tetgen
 
 BRACKET = os.path.join(ROOT, "resources", "samples", "bracket.step")
 

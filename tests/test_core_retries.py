@@ -24,8 +24,8 @@ partition that made the mesh.
 
 import os
 
-from FemBspTet import core
-from FemBspTet.surface_io import read_surface
+from FemBspTet.kernel import core
+from FemBspTet.io.surface_io import read_surface
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from conftest import PAPER_MODELS, corpus_path, paper_path
 
-from FemBspTet import core
-from FemBspTet.mesh_types import Surface
-from FemBspTet.surface_io import read_surface
+from FemBspTet.kernel import core
+from FemBspTet.kernel.mesh_types import Surface
+from FemBspTet.io.surface_io import read_surface
 
 MODELS = [paper_path(m) for m in PAPER_MODELS] + [corpus_path(m) for m in ("cube", "star",
                                                                              "tinytorus")]

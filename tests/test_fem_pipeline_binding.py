@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from FemBspTet import _bsptet
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.freecad_env import freecad_available
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
 
@@ -70,7 +70,7 @@ def test_cancel_raises_meshing_error():
 @pytest.mark.skipif(not freecad_available(), reason="FreeCAD (freecad-python3) is not available")
 @pytest.mark.parametrize("order", [1, 2])
 def test_mesh_cad_brep_nodes_found_by_face(order):
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     freecad = import_freecad()
     import Fem

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Tests of FemBspTet.freecad_export (TetMesh <-> Fem.FemMesh, mesh files through FreeCAD).
+"""Tests of FemBspTet.freecad.femmesh (TetMesh <-> Fem.FemMesh, mesh files through FreeCAD).
 
 Run with Debian's interpreter from the checkout: ``/usr/bin/python3 -m pytest -q tests``.
 Skipped when FreeCAD (Debian package freecad-python3) is not available.
@@ -11,15 +11,15 @@ import re
 import numpy as np
 import pytest
 
-from FemBspTet.errors import InputError, InternalError
-from FemBspTet.freecad_env import freecad_available
-from FemBspTet.mesh_types import TetMesh
+from FemBspTet.kernel.errors import InputError, InternalError
+from FemBspTet.kernel.freecad_env import freecad_available
+from FemBspTet.kernel.mesh_types import TetMesh
 
 if not freecad_available():
     pytest.skip("FreeCAD (Debian package freecad-python3) is not available in this interpreter",
                 allow_module_level=True)
 
-from FemBspTet import freecad_export as fx  # noqa: E402
+from FemBspTet.freecad import femmesh as fx  # noqa: E402
 
 FORMATS = [".unv", ".med", ".z88", ".vtk", ".vtu", ".inp"]
 # SMESH / CalculiX C3D10 mid-edge order: edge (i, j) of the corners for mid-node 4..9
@@ -29,7 +29,7 @@ TET10_EDGES = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
 @pytest.fixture(scope="module")
 def Fem():
     """FreeCAD's Fem module, bootstrapped once per test process."""
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     import_freecad()
     import Fem as fem_module
@@ -211,8 +211,8 @@ def test_tetmesh_to_femmesh_rejects_bad_meshes(Fem, change, pattern):
 
 
 def test_groups_become_faces_and_named_groups(Fem):
-    from FemBspTet.core import boundary_surface
-    from FemBspTet.mesh_types import MeshGroups
+    from FemBspTet.kernel.core import boundary_surface
+    from FemBspTet.kernel.mesh_types import MeshGroups
 
     mesh = cube_tet4()
     tri = boundary_surface(mesh).triangles

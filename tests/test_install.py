@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.freecad_env import freecad_available
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUILD = os.environ.get("FEMBSPTET_BUILD_DIR", os.path.join(ROOT, "build"))
@@ -53,14 +53,14 @@ def test_the_installed_command_meshes_from_anywhere(prefix, tmp_path):
     # the installed package did the work, not the checkout
     r = subprocess.run(["/usr/bin/python3", "-c",
                         "import site, sys; site.addsitedir(sys.argv[1]); import FemBspTet, "
-                        "FemBspTet.core as c; print(FemBspTet.__file__); print(c._native().__file__)",
+                        "FemBspTet.kernel.core as c; print(FemBspTet.__file__); print(c.native().__file__)",
                         str(prefix / "lib" / PY / "dist-packages")],
                        cwd=tmp_path, env=clean_env(tmp_path), capture_output=True, text=True,
                        timeout=120)
     assert r.returncode == 0, r.stderr
     package, native = r.stdout.split()
     assert package.startswith(str(addon)) and native.startswith(str(addon))
-    from FemBspTet.volume_io import read_tet_mesh
+    from FemBspTet.io.volume_io import read_tet_mesh
 
     mesh = read_tet_mesh(out)
     assert mesh.tets.shape[1] == 10 and np.isfinite(mesh.points).all()
@@ -92,8 +92,8 @@ def test_freecad_install_links_the_installed_addon(prefix, tmp_path):
 
 
 def test_freecad_install_leaves_a_foreign_folder_alone(tmp_path):
-    from FemBspTet.addon_install import install
-    from FemBspTet.errors import InputError
+    from FemBspTet.cli.addon_install import install
+    from FemBspTet.kernel.errors import InputError
 
     mod = tmp_path / "Mod"
     (mod / "FemBspTet").mkdir(parents=True)

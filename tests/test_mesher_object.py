@@ -11,16 +11,16 @@ import os
 import numpy as np
 import pytest
 
-from FemBspTet.errors import InputError, MeshingCancelled
-from FemBspTet.freecad_env import freecad_available
+from FemBspTet.kernel.errors import InputError, MeshingCancelled
+from FemBspTet.kernel.freecad_env import freecad_available
 
 if not freecad_available():
     pytest.skip("FreeCAD (Debian package freecad-python3) is not available",
                 allow_module_level=True)
 
 import FemBspTet  # noqa: E402
-from FemBspTet import core  # noqa: E402
-from FemBspTet import mesh_pipeline as mp  # noqa: E402
+from FemBspTet.kernel import core  # noqa: E402
+from FemBspTet.fem import mesh_pipeline as mp  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
 
@@ -132,9 +132,9 @@ def test_run_mesher_tet4_smesh_conventions_and_face_nodes(doc, fc):
 
 
 def test_tetgen_properties_of_a_skipped_tetgen_row(doc, fc, monkeypatch, tmp_path):
-    from FemBspTet.mesh_pipeline import run_tetgen_comparison
-    from FemBspTet.mesher_tools import set_tetgen_properties
-    from FemBspTet.surface_io import read_surface
+    from FemBspTet.compare.comparison import run_tetgen_comparison
+    from FemBspTet.freecad.mesher_tools import set_tetgen_properties
+    from FemBspTet.io.surface_io import read_surface
     from conftest import paper_path
 
     monkeypatch.setenv("PATH", str(tmp_path))  # no tetgen on it
@@ -353,7 +353,7 @@ def test_mesh_shape_returns_a_femmesh(fc):
 # ------------------------------------------------------------------------------- worker
 
 def test_worker_process_gives_the_same_mesh_as_in_process(fc):
-    from FemBspTet.mesh_worker import MeshJob
+    from FemBspTet.freecad.mesh_worker import MeshJob
 
     shape = block_with_hole(fc)
     params = mp.MeshParameters(order=1, compare_tetgen=False)
@@ -370,7 +370,7 @@ def test_worker_process_gives_the_same_mesh_as_in_process(fc):
 
 
 def test_worker_reports_input_errors_and_can_be_cancelled(fc):
-    from FemBspTet.mesh_worker import MeshJob
+    from FemBspTet.freecad.mesh_worker import MeshJob
 
     _, Part, _ = fc
     job = MeshJob(Part.Shell(Part.makeBox(1, 1, 1).Faces[:5]), mp.MeshParameters(),
@@ -435,7 +435,7 @@ def test_save_and_reload(doc, fc, tmp_path):
 
 @pytest.mark.parametrize("ext", [".inp", ".unv", ".vtk", ".vtu", ".med", ".z88"])
 def test_export(doc, fc, tmp_path, ext):
-    from FemBspTet.freecad_export import read_via_freecad
+    from FemBspTet.freecad.femmesh import read_via_freecad
 
     _, Part, _ = fc
     part = add_part(doc, fc, Part.makeCylinder(3, 7))

@@ -8,9 +8,9 @@ import pytest
 from analytic_surfaces import lat_long_sphere
 from conftest import PAPER_MODELS, corpus_path, paper_path
 
-from FemBspTet import core
-from FemBspTet.mesh_types import Surface
-from FemBspTet.surface_io import read_surface
+from FemBspTet.kernel import core
+from FemBspTet.kernel.mesh_types import Surface
+from FemBspTet.io.surface_io import read_surface
 
 
 def _mesh_and_check(surface, label):

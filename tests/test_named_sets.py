@@ -13,10 +13,10 @@ import meshio
 import numpy as np
 import pytest
 
-from FemBspTet.cli import main
+from FemBspTet.cli.main import main
 from FemBspTet.fem.cad_mesh import mesh_cad_file
-from FemBspTet.freecad_env import freecad_available
-from FemBspTet.volume_io import read_tet_mesh
+from FemBspTet.kernel.freecad_env import freecad_available
+from FemBspTet.io.volume_io import read_tet_mesh
 
 PART = os.path.join(os.path.dirname(__file__), "data", "cad", "red_cube_blue_cylinder.step")
 FORMATS = ["m.vtu", "m.msh", "m.inp", "m.mesh", "m.node"]
@@ -135,7 +135,7 @@ def test_medit_and_tetgen_regions(written):
 def test_freecad_reads_the_groups(written, name):
     out, result = written
     groups = result.groups
-    from FemBspTet.freecad_env import import_freecad
+    from FemBspTet.kernel.freecad_env import import_freecad
 
     import_freecad()
     import Fem

@@ -11,17 +11,18 @@ import numpy as np
 import pytest
 from conftest import DATA, corpus_path
 
-from FemBspTet import core
-from FemBspTet.errors import InputError, MemoryBudgetError
-from FemBspTet.memory_budget import BASE_BYTES
-from FemBspTet.surface_io import read_surface
-from FemBspTet.volume_io import read_tet_mesh
+from FemBspTet.kernel import core
+from FemBspTet.kernel.errors import InputError, MemoryBudgetError
+from FemBspTet.kernel.memory_budget import BASE_BYTES
+from FemBspTet.io.surface_io import read_surface
+from FemBspTet.io.volume_io import read_tet_mesh
+from FemBspTet.fem.pieces import OUT_OF_CORE_HOLD_PER_TRIANGLE, tetrahedralize_out_of_core
 
 
 def budget_for_pieces(surface, piece_triangles):
     """The budget under which tetrahedralize_out_of_core cuts ``surface`` into pieces of about
     ``piece_triangles`` triangles (out_of_core.h's estimate: 32 MiB + 2 KiB per triangle)."""
-    return (BASE_BYTES + core.OUT_OF_CORE_HOLD_PER_TRIANGLE * len(surface.triangles)
+    return (BASE_BYTES + OUT_OF_CORE_HOLD_PER_TRIANGLE * len(surface.triangles)
             + (32 << 20) + 2048 * piece_triangles)
 
 
@@ -35,7 +36,7 @@ def assert_valid_mesh_of(surface, mesh):
 @pytest.mark.parametrize("name", ["fertility", "knot2", "fandisk"])
 def test_pieces_make_one_valid_mesh(name):
     surface = read_surface(corpus_path(name))
-    mesh, stats = core.tetrahedralize_out_of_core(surface, budget_for_pieces(surface, 2500))
+    mesh, stats = tetrahedralize_out_of_core(surface, budget_for_pieces(surface, 2500))
     assert_valid_mesh_of(surface, mesh)
     pieces = stats["out_of_core"]
     assert pieces["pieces"] >= 3
@@ -50,11 +51,11 @@ def test_pieces_make_one_valid_mesh(name):
 def test_out_of_core_refuses_what_it_cannot_do():
     surface = read_surface(corpus_path("spot"))
     with pytest.raises(InputError, match="--out-of-core|out-of-core mode makes the core's mesh only"):
-        core.tetrahedralize_out_of_core(surface, 1 << 30, options={"size": 0.1})
+        tetrahedralize_out_of_core(surface, 1 << 30, options={"size": 0.1})
     with pytest.raises(InputError, match="allow_boundary_steiner"):
-        core.tetrahedralize_out_of_core(surface, 1 << 30, options={"allow_boundary_steiner": True})
+        tetrahedralize_out_of_core(surface, 1 << 30, options={"allow_boundary_steiner": True})
     with pytest.raises(MemoryBudgetError, match="too small even for the out-of-core mode"):
-        core.tetrahedralize_out_of_core(surface, 64 << 20)
+        tetrahedralize_out_of_core(surface, 64 << 20)
 
 
 def run(cli, *args):

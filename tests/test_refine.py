@@ -13,10 +13,10 @@ from analytic_surfaces import (cylinder, cylinder_distance, cylinder_projection,
                                sphere_distance, sphere_projection, tube, tube_distance,
                                tube_projection)
 from conftest import corpus_path, paper_path
-from FemBspTet import core
-from FemBspTet.errors import InputError
-from FemBspTet.mesh_types import Surface
-from FemBspTet.surface_io import read_surface
+from FemBspTet.kernel import core
+from FemBspTet.kernel.errors import InputError
+from FemBspTet.kernel.mesh_types import Surface
+from FemBspTet.io.surface_io import read_surface
 
 EDGES10 = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))  # m12 m23 m31 m14 m24 m34
 
@@ -147,7 +147,7 @@ def test_optimization_rounds_do_not_grow_the_mesh_without_raising_its_angles(nam
     4,066, 2.84 -> 4.24)."""
     surface = read_surface(corpus_path(name))
     mesh, _ = core.tetrahedralize(surface)
-    native = core._native()
+    native = core.native()
     results = {}
     for rounds in (1, 8):
         points, tets, st = native.refine(surface.points, surface.triangles, None, mesh.points,

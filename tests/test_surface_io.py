@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Tests of FemBspTet.surface_io (OFF, STL, OBJ, PLY) and FemBspTet.atomic_file.
+"""Tests of FemBspTet.io.surface_io (OFF, STL, OBJ, PLY) and FemBspTet.io.atomic_file.
 
 All data are made here; nothing is read from outside the test's tmp_path.
 """
@@ -12,11 +12,11 @@ import meshio
 import numpy as np
 import pytest
 
-from FemBspTet import surface_io
-from FemBspTet.atomic_file import atomic_output, atomic_outputs
-from FemBspTet.errors import InputError, InternalError
-from FemBspTet.mesh_types import Surface
-from FemBspTet.surface_io import read_surface, write_surface
+from FemBspTet.io import surface_io
+from FemBspTet.io.atomic_file import atomic_output, atomic_outputs
+from FemBspTet.kernel.errors import InputError, InternalError
+from FemBspTet.kernel.mesh_types import Surface
+from FemBspTet.io.surface_io import read_surface, write_surface
 
 
 # ------------------------------------------------------------------------------------------

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Fins of a CAD tessellation (FemBspTet.cad_tessellation.flip_out_fins): a near-collinear triangle
+"""Fins of a CAD tessellation (FemBspTet.io.cad_tessellation.flip_out_fins): a near-collinear triangle
 along a CAD edge is flipped away inside its face, nothing else changes, and the flat tet it forced
 goes with it.
 
@@ -12,9 +12,9 @@ area. The meshes go through the core with separate_face_tags.
 
 import numpy as np
 
-from FemBspTet import core
-from FemBspTet.cad_tessellation import flip_out_fins
-from FemBspTet.mesh_types import Surface
+from FemBspTet.kernel import core
+from FemBspTet.io.cad_tessellation import flip_out_fins
+from FemBspTet.kernel.mesh_types import Surface
 
 OFFSET = np.array([103.5, -7.25, 11.0])
 
@@ -108,12 +108,12 @@ def test_the_command_line_flips_the_fins_of_a_cad_file():
 
     import pytest
 
-    from FemBspTet.freecad_env import freecad_available
+    from FemBspTet.kernel.freecad_env import freecad_available
 
     if not freecad_available():
         pytest.skip("FreeCAD (Debian package freecad-python3) is not available")
-    from FemBspTet.cad_tessellation import tessellate_file
-    from FemBspTet.cli import load_input
+    from FemBspTet.io.cad_tessellation import tessellate_file
+    from FemBspTet.cli.main import load_input
 
     path = os.path.join(os.path.dirname(__file__), "data", "cad", "bottle.brep")
     raw, = tessellate_file(path)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from analytic_surfaces import icosphere, sphere_projection
-from FemBspTet import core
-from FemBspTet.mesh_types import TetMesh
+from FemBspTet.kernel import core
+from FemBspTet.kernel.mesh_types import TetMesh
 
 EDGES10 = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))  # m12 m23 m31 m14 m24 m34
 

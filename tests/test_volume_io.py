@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Tests of FemBspTet.volume_io (VTU, MSH, INP, TetGen, Medit).
+"""Tests of FemBspTet.io.volume_io (VTU, MSH, INP, TetGen, Medit).
 
 Meshes are built here: a box split into 6 positively oriented Kuhn tets, and its tet10 version
 with mid-edge nodes. Every written format is read back by our reader and by meshio. Tests that
@@ -17,10 +17,10 @@ import meshio
 import numpy as np
 import pytest
 
-from FemBspTet import volume_io
-from FemBspTet.errors import InputError, InternalError
-from FemBspTet.mesh_types import Surface, TetMesh
-from FemBspTet.volume_io import (read_tet_mesh, read_tetgen, stored_points, surface_groups,
+from FemBspTet.io import volume_io
+from FemBspTet.kernel.errors import InputError, InternalError
+from FemBspTet.kernel.mesh_types import Surface, TetMesh
+from FemBspTet.io.volume_io import (read_tet_mesh, read_tetgen, stored_points, surface_groups,
                                  tetgen_paths, write_tet_mesh)
 
 

@@ -16,12 +16,21 @@ import os
 import platform
 import statistics
 import subprocess
+import json
+import numpy as np
+import re
+import tempfile
+import time
 
-from ..cli import CAD_EXTENSIONS, SURFACE_EXTENSIONS
-from ..errors import BspTetError
-from .comparison import (COLUMNS, GMSH, OURS, OURS_NATIVE, TETGEN_PY, compare, draw_histograms,
-                         row_label)
-from .process import DEFAULT_TIMEOUT
+from ..io.atomic_file import atomic_output
+from ..io.formats import CAD_EXTENSIONS, SURFACE_EXTENSIONS
+from ..io.inputs import load_input
+from ..kernel.errors import BspTetError
+from ..kernel.paths import ADDON_DIR
+from ..peers.gmsh import gmsh_version
+from ..peers.process import DEFAULT_TIMEOUT
+from .comparison import (COLORS, COLUMNS, compare, Comparison, draw_histograms, GMSH, MESHERS,
+                         OURS, OURS_NATIVE, Row, row_label, TETGEN_PY)
 
 #: Extensions the benchmark takes from a folder (the inputs of ``fembsptet mesh``).
 MODEL_EXTENSIONS = SURFACE_EXTENSIONS + CAD_EXTENSIONS
@@ -60,10 +69,7 @@ def run_benchmark(paths, timeout=DEFAULT_TIMEOUT, divisions=None, meshers=None, 
     REPEAT_BELOW_SECONDS runs ``repeats`` times in all, the meshers taking turns, and its seconds
     are the median of its runs (its other figures are the first run's). Returns a list of
     :class:`Entry`."""
-    import numpy as np
 
-    from ..cli import load_input
-    from .comparison import MESHERS
 
     entries = []
     for path in paths:
@@ -90,7 +96,6 @@ def run_benchmark(paths, timeout=DEFAULT_TIMEOUT, divisions=None, meshers=None, 
 
 def _repeat_short_runs(comparison, surfaces, size, timeout, repeats):
     """Replaces the seconds of the short successful rows by the median over ``repeats`` runs."""
-    import statistics
 
     short = [r for r in comparison.rows
              if r.status == "ok" and r.seconds is not None and r.seconds < REPEAT_BELOW_SECONDS]
@@ -179,12 +184,10 @@ def environment():
             debian = f.read().strip()
     except OSError:
         pass
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    root = ADDON_DIR
     commit = _first_line(["git", "-C", root, "rev-parse", "--short=12", "HEAD"])
     dirty = _first_line(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"])
-    from .gmsh_backend import gmsh_version
 
-    import time
 
     return [("date", time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())),
             ("CPU", f"{cpu} ({os.cpu_count()} logical cores)"), ("RAM", ram),
@@ -200,8 +203,6 @@ def environment():
 def _short_message(message):
     """``message`` without the comparison's temporary folder (``fembsptet_compare_*/`` in the
     system's temporary directory)."""
-    import re
-    import tempfile
 
     folder = re.escape(os.path.join(tempfile.gettempdir(), "fembsptet_compare_"))
     return re.sub(folder + r"[^/\s]*/", "", message)
@@ -306,7 +307,6 @@ def plot_benchmark(path, entries, cols=6):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..atomic_file import atomic_output
 
     shown = [e for e in entries if e.comparison is not None
              and any(r.status == "ok" for r in e.comparison.rows)]
@@ -323,7 +323,6 @@ def plot_benchmark(path, entries, cols=6):
         ax.axis("off")
     from matplotlib.lines import Line2D
 
-    from .comparison import COLORS
 
     seen = {}
     for e in shown:
@@ -344,9 +343,7 @@ def plot_benchmark(path, entries, cols=6):
 def save_entries(path, entries, command, env):
     """Every figure of the run as JSON (``<stem>.json`` beside the report), so the report can be
     made again (:func:`load_entries`) without running the meshers again."""
-    import json
 
-    from ..atomic_file import atomic_output
 
     data = {"command": command, "environment": env,
             "entries": [{"name": e.name, "path": e.path, "error": e.error,
@@ -358,9 +355,7 @@ def save_entries(path, entries, command, env):
 
 def load_entries(path):
     """``(entries, command, env)`` from a file written by :func:`save_entries`."""
-    import json
 
-    from .comparison import Comparison, Row
 
     with open(path) as f:
         data = json.load(f)
@@ -378,7 +373,6 @@ def load_entries(path):
 def write_report(path, entries, command="", png=True, env=None):
     """Writes the markdown report, ``<stem>.png`` (histograms) and ``<stem>.json`` (every
     figure) beside it. Returns the PNG path or None."""
-    from ..atomic_file import atomic_output
 
     env = environment() if env is None else env
     save_entries(os.path.splitext(path)[0] + ".json", entries, command, env)

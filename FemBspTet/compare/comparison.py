@@ -43,10 +43,22 @@ import shutil
 import tempfile
 
 import numpy as np
+from types import SimpleNamespace
 
-from ..errors import BspTetError, InternalError
-from ..mesh_types import Surface, TetMesh
-from .process import DEFAULT_TIMEOUT, run_measured
+from ..fem.mesh_pipeline import TETGEN_SWITCHES
+from ..io import cad_tessellation
+from ..io.atomic_file import atomic_output
+from ..io.surface_io import write_surface
+from ..io.volume_io import read_tet_mesh, read_tetgen
+from ..kernel import core
+from ..kernel.core import boundary_surface
+from ..kernel.errors import BspTetError, InputError, InternalError
+from ..kernel.mesh_types import Surface, TetMesh
+from ..kernel.paths import ADDON_DIR
+from ..peers.gmsh import gmsh_available, gmsh_command, mean_edge_length, run_gmsh
+from ..peers.process import DEFAULT_TIMEOUT, run_measured, worker_env
+from ..peers.tetgen import quality_switches, run_tetgen, tetgen_available
+from .ours_worker import ours_mesh_path
 
 OURS, TETGEN_PY, TETGEN_PQ, GMSH = "ours", "tetgen-pY", "tetgen-pq", "gmsh"
 #: Our core alone as a native program (``build/cpp_module/bsptet_mesh --no-check``), for timing
@@ -164,7 +176,6 @@ def _point_keys(points):
 def steiner_points(surface: Surface, mesh: TetMesh):
     """``(interior, boundary)``: boolean masks over ``mesh.points`` of the nodes that are not
     vertices of ``surface`` (exact coordinates), inside the mesh and on its boundary."""
-    from ..core import boundary_surface
 
     new = ~np.isin(_point_keys(mesh.points), _point_keys(surface.points))
     on_boundary = np.zeros(len(mesh.points), dtype=bool)
@@ -175,7 +186,6 @@ def steiner_points(surface: Surface, mesh: TetMesh):
 def evaluate(surfaces, meshes):
     """Counts, quality and validity of ``meshes`` (one per surface, same order), summed over
     the solids. Returns a dict of :class:`Row` fields."""
-    from .. import core
 
     out = {"nodes": 0, "tets": 0, "steiner_interior": 0, "steiner_boundary": 0, "valid": True}
     checks, messages = set(), []
@@ -193,7 +203,7 @@ def evaluate(surfaces, meshes):
         checks.add(what)
         out["valid"] = out["valid"] and bool(report["valid"])
         messages += list(report["messages"])
-    q = core.tet_quality(_concatenate(meshes))
+    q = core.tet_quality(concatenate_meshes(meshes))
     out.update(min_dihedral_deg=q["min_dihedral_deg"], p1_dihedral_deg=q["p1_dihedral_deg"],
                median_dihedral_deg=q["median_dihedral_deg"],
                max_radius_edge_ratio=q["max_radius_edge_ratio"],
@@ -202,7 +212,7 @@ def evaluate(surfaces, meshes):
     return out
 
 
-def _concatenate(meshes):
+def concatenate_meshes(meshes):
     if len(meshes) == 1:
         return meshes[0]
     offsets = np.cumsum([0] + [len(m.points) for m in meshes[:-1]])
@@ -224,10 +234,6 @@ def _error_line(text):
 
 
 def _run_ours(surfaces, size, timeout, workdir, python, options=None):
-    from ..mesh_worker import worker_env
-    from ..surface_io import write_surface
-    from ..volume_io import read_tet_mesh
-    from .ours_worker import ours_mesh_path
 
     opts = dict(options or {})
     if size is not None:
@@ -249,7 +255,7 @@ def _run_ours(surfaces, size, timeout, workdir, python, options=None):
 def core_tool_path():
     """``bsptet_mesh``, the core's command-line program, or None: ``$FEMBSPTET_CORE_TOOL``, else
     the checkout's build (scripts/setup.sh), else an installed addon's ``libexec``."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    root = ADDON_DIR
     candidates = [os.environ.get("FEMBSPTET_CORE_TOOL")] if os.environ.get(
         "FEMBSPTET_CORE_TOOL") else [os.path.join(root, "build", "cpp_module", "bsptet_mesh"),
                                      os.path.join(root, "libexec", "bsptet_mesh")]
@@ -260,10 +266,7 @@ def core_tool_path():
 
 
 def _run_ours_native(surfaces, timeout, workdir):
-    from types import SimpleNamespace
 
-    from ..surface_io import write_surface
-    from ..volume_io import read_tetgen
 
     exe = core_tool_path()
     if exe is None:
@@ -306,7 +309,6 @@ def _run_per_solid(run_one, surfaces, timeout):
 
 
 def _run_tetgen(surfaces, switches, timeout, workdir):
-    from .tetgen_backend import run_tetgen, tetgen_available
 
     if not tetgen_available():
         raise MesherFailed("skipped", "tetgen is not installed (Debian package tetgen)")
@@ -320,7 +322,6 @@ def _run_tetgen(surfaces, switches, timeout, workdir):
 
 
 def _run_gmsh(surfaces, size, timeout, workdir, remesh_surface):
-    from .gmsh_backend import gmsh_available, run_gmsh
 
     if not gmsh_available():
         raise MesherFailed("skipped", "gmsh is not installed (Debian package gmsh)")
@@ -338,7 +339,6 @@ def tetgen_pY_row(surfaces, timeout=DEFAULT_TIMEOUT, workdir=None):
 
 
 def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, ours_options):
-    from .tetgen_backend import quality_switches
 
     own_dir = workdir is None
     workdir = workdir or tempfile.mkdtemp(prefix="fembsptet_compare_")
@@ -351,7 +351,6 @@ def _mesher_row(mesher, surfaces, size, timeout, workdir, gmsh_size, python, our
     elif mesher == TETGEN_PQ:
         command = "tetgen -" + quality_switches(size)
     else:
-        from .gmsh_backend import gmsh_command
 
         command = gmsh_command(gmsh_size, remesh_surface=size is not None)
     row = Row(mesher=mesher, command=command)
@@ -396,7 +395,6 @@ def compare(surfaces, size=None, timeout=DEFAULT_TIMEOUT, workdir=None, meshers=
     ``tetgen -pq1.414a<V(H)>`` and Gmsh at H with the surface remeshed. ``workdir``: keep every mesher's files there (else a temporary directory, removed).
     ``ours_options``: more options for our mesher (e.g. ``{"surface_points": "rounded"}``).
     """
-    from .gmsh_backend import mean_edge_length
 
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
@@ -489,7 +487,6 @@ def format_table(result: Comparison) -> str:
 
 
 def write_json(path, result: Comparison):
-    from ..atomic_file import atomic_output
 
     with atomic_output(path) as f:
         json.dump(result.to_dict(), f, indent=1)
@@ -523,7 +520,6 @@ def plot_histograms(path, result: Comparison):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..atomic_file import atomic_output
 
     rows = [r for r in result.rows if r.status == "ok"]
     fig, axes = plt.subplots(1, max(len(rows), 1), figsize=(3.2 * max(len(rows), 1), 2.6),
@@ -543,3 +539,31 @@ def plot_histograms(path, result: Comparison):
     with atomic_output(path, "wb") as f:
         fig.savefig(f, format="png", dpi=80)
     plt.close(fig)
+
+
+# ------------------------------------------------------------------------------------------
+# the FreeCAD object's comparison: TetGen on OpenCASCADE's display tessellation
+# ------------------------------------------------------------------------------------------
+
+def tetgen_comparison_of(shape, max_size=0.0, source=""):
+    """``tetgen -pY`` on OpenCASCADE's display tessellation of ``shape`` (default deflection for
+    the element size, fins flipped away as ``fembsptet mesh --tessellation`` does): the
+    comparison's row as a dict. A shape OpenCASCADE cannot tessellate into closed surfaces is a
+    row with ``status`` "failed" and the reason (never raises for that)."""
+    size = max_size if max_size > 0 else None
+    try:
+        surfaces = cad_tessellation.tessellate_shape(
+            shape, cad_tessellation.default_linear_deflection(shape, size), source=source)
+    except InputError as e:
+        return row_dict(Row(mesher=TETGEN_PY, command="tetgen -%s" % TETGEN_SWITCHES,
+                            status="failed",
+                            message="OpenCASCADE's tessellation: %s" % str(e)[:300]))
+    surfaces, _ = cad_tessellation.flip_out_fins_of(surfaces)
+    return run_tetgen_comparison(surfaces)
+
+
+def run_tetgen_comparison(surfaces):
+    """``tetgen -pY`` on the surfaces: the comparison's row (:func:`FemBspTet.compare.comparison.
+    tetgen_pY_row`) as a dict; a missing or failing TetGen is a row with ``status`` and
+    ``message`` (never raises)."""
+    return row_dict(tetgen_pY_row(surfaces))

@@ -7,12 +7,18 @@ Gmsh (wall time and peak memory of one process, :func:`.process.run_measured`).
 Meshes each surface (one per solid) with ``core.tetrahedralize(surface, options)`` and writes
 ``OUT_DIR/<surface stem>.vtu`` (round-trip precision) and ``OUT_DIR/ours_stats.json`` (the
 core's stats per solid). Errors are reported as ``fembsptet`` reports them (one line on stderr,
-exit 2 for bad input, 1 otherwise: :func:`FemBspTet.cli._run_reporting`).
+exit 2 for bad input, 1 otherwise: :func:`FemBspTet.kernel.errors.report_errors`).
 """
 
 import json
 import os
 import sys
+
+from ..io.atomic_file import atomic_output
+from ..io.surface_io import read_surface
+from ..io.volume_io import write_tet_mesh
+from ..kernel import core
+from ..kernel.errors import report_errors
 
 
 def ours_mesh_path(out_dir, surface_path):
@@ -22,10 +28,6 @@ def ours_mesh_path(out_dir, surface_path):
 
 
 def _run(args):
-    from .. import core
-    from ..atomic_file import atomic_output
-    from ..surface_io import read_surface
-    from ..volume_io import write_tet_mesh
 
     options_json, out_dir, paths = args
     options = json.loads(options_json)
@@ -40,14 +42,12 @@ def _run(args):
 
 
 def main(argv=None):
-    from ..cli import _run_reporting
-
     argv = list(sys.argv[1:] if argv is None else argv)
     if len(argv) < 3:
         print("usage: python3 -m FemBspTet.compare.ours_worker OPTIONS_JSON OUT_DIR SURFACE...",
               file=sys.stderr)
         return 2
-    return _run_reporting(_run, (argv[0], argv[1], argv[2:]))
+    return report_errors(_run, (argv[0], argv[1], argv[2:]))
 
 
 if __name__ == "__main__":

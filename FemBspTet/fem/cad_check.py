@@ -4,9 +4,9 @@
     report = check_against_cad("part.step", read_tet_mesh("part.inp"))
     report["valid"], report["on_cad"], report["max_distance"], report["messages"]
 
-* The mesh itself, exactly (:func:`FemBspTet.core.check_mesh` with the mesh's own boundary as the
+* The mesh itself, exactly (:func:`FemBspTet.kernel.core.check_mesh` with the mesh's own boundary as the
   reference): positive corner tets, conforming faces, a closed boundary; for tet10 the Jacobian
-  certified positive over every element (:func:`FemBspTet.core.certify_tet10`).
+  certified positive over every element (:func:`FemBspTet.kernel.core.certify_tet10`).
 * Its boundary on the CAD: every boundary node (corners and, for tet10, the mid-nodes of the
   boundary triangles' edges) within its CAD face's tolerance (OpenCASCADE's
   ``BRep_Tool::Tolerance``, what FreeCAD's ``getNodesByFace`` compares with) of that face. The
@@ -20,7 +20,8 @@ exact check of the whole mesh reports those faces as crossing: check such a mesh
 
 import numpy as np
 
-from ..mesh_types import TetMesh
+from ..kernel.core import native, boundary_surface, certify_tet10, check_mesh
+from ..kernel.mesh_types import TetMesh
 
 #: boundary triangle edges (a, b), (b, c), (c, a) -> our tet10 mid-node columns by corner pair
 _EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
@@ -75,7 +76,6 @@ def check_against_cad(cad_path, mesh: TetMesh, max_messages=20):
     with its ``max_distance_face`` (1-based, FreeCAD's Face<n>) and ``max_distance_tolerance``,
     ``faces_tagged`` (nodes measured to the face their file names), ``on_cad`` and
     ``messages``."""
-    from ..core import _native, boundary_surface, certify_tet10, check_mesh
 
     boundary = boundary_surface(mesh)
     report = check_mesh(boundary, TetMesh(mesh.points, mesh.tets, source=mesh.source),
@@ -98,7 +98,7 @@ def check_against_cad(cad_path, mesh: TetMesh, max_messages=20):
     nodes, tags = nodes[order], tags[order]
     first = np.concatenate([[True], nodes[1:] != nodes[:-1]])
     nodes, tags = nodes[first], tags[first]
-    distance, face, tolerance = _native().cad_face_distances(
+    distance, face, tolerance = native().cad_face_distances(
         str(cad_path), np.ascontiguousarray(mesh.points[nodes]), tags.astype(np.int32))
     distance, face = np.asarray(distance), np.asarray(face)
     limit = np.asarray(tolerance)[face]

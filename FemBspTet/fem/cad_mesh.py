@@ -18,8 +18,9 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InputError
-from ..mesh_types import MeshGroups, Surface, TetMesh
+from ..kernel.core import core_errors, native, boundary_surface, check_mesh
+from ..kernel.errors import InputError, InternalError
+from ..kernel.mesh_types import MeshGroups, Surface, TetMesh
 
 
 @dataclasses.dataclass
@@ -55,8 +56,6 @@ def _check_each_solid(points, corner_tets, tet_solid, cad_triangles, source):
     """The exact check of every solid's corner tets against the faces of exactly one of its tets,
     and those faces equal to CAD triangles (``cad_triangles``, merged ids), every CAD triangle a
     face of a tet; InternalError naming the solid if one fails."""
-    from ..core import boundary_surface, check_mesh
-    from ..errors import InternalError
 
     cad_keys = _row_keys(cad_triangles)
     tet_faces = np.concatenate([corner_tets[:, [0, 1, 2]], corner_tets[:, [0, 1, 3]],
@@ -118,9 +117,8 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
         if not np.isfinite(value) or value < 0:
             raise InputError(f"{name} must be a finite number >= 0 (0: automatic), got {value}",
                              where=source)
-    from ..core import _core_errors
 
-    with _core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
+    with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                               source=""), "FEM mesh"):
         points, tets, tet_solid, tri, tri_face, stats = native_call(
             size=float(size or 0.0), min_size=float(min_size or 0.0), order=int(order),
@@ -172,16 +170,14 @@ def mesh_cad_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=N
     """Meshes every solid of a STEP, BREP or IGES file (see the module doc). ``progress(stage,
     fraction)`` and ``cancel() -> bool`` are optional. Raises InputError (unreadable or
     unmeshable part, naming the CAD face or solid; bad option) or MeshingError."""
-    from ..core import _native
 
-    return _run(lambda **kw: _native().mesh_cad_file(str(path), **kw), str(path), size, min_size,
+    return _run(lambda **kw: native().mesh_cad_file(str(path), **kw), str(path), size, min_size,
                 order, progress, cancel, size_by_face)
 
 
 def mesh_cad_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
                   size_by_face=None, source="BREP string"):
     """The same for a shape in OpenCASCADE's BREP text (FreeCAD's ``Shape.exportBrepToString()``)."""
-    from ..core import _native
 
-    return _run(lambda **kw: _native().mesh_cad_brep(brep, **kw), source, size, min_size, order,
+    return _run(lambda **kw: native().mesh_cad_brep(brep, **kw), source, size, min_size, order,
                 progress, cancel, size_by_face)

@@ -28,9 +28,10 @@ import shutil
 import subprocess
 
 import numpy as np
+import time
 
-from ..errors import InternalError
-from ..volume_io import write_tet_mesh
+from ..kernel.errors import InternalError
+from ..io.volume_io import write_tet_mesh
 
 TOTAL_FORCE_N = 1000.0
 
@@ -136,7 +137,6 @@ def solve_face_load(result, workdir, ccx=None, timeout=1800):
     "seconds", "applied_force" (the pressures' resultant), "reaction_force" (on the fixed
     faces; it balances the applied force when "loads_touching_fixed_faces" is 0)}. Raises InternalError with CalculiX's message when it refuses or fails, or when a
     displacement is not finite or a fixed node moved."""
-    import time
 
     ccx = ccx or shutil.which("ccx")
     if ccx is None:

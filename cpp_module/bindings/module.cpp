@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // pybind11 bindings of the FemBspTet core: `FemBspTet._bsptet`. Converts and validates only; the
-// public Python API lives in FemBspTet/core.py. Messages name the expected array shapes.
+// public Python API lives in FemBspTet/kernel/core.py. Messages name the expected array shapes.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

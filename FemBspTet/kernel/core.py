@@ -18,7 +18,9 @@ import contextlib
 
 import numpy as np
 
+from .. import __version__
 from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
+from .memory_budget import require_within_budget
 from .mesh_types import Surface, TetMesh
 
 
@@ -28,15 +30,15 @@ MIDNODES_STRAIGHTENED_NOTE = ("curved mid-nodes were put back on their chord (th
 
 
 @contextlib.contextmanager
-def _core_errors(surface, stage):
+def core_errors(surface, stage):
     """The core's errors as the package's: InputError (naming the input), Cancelled, and
     InternalError for anything else (a bug of ours: the message asks for a report)."""
-    native = _native()
+    lib = native()
     try:
         yield
-    except native.InputError as exc:
+    except lib.InputError as exc:
         raise InputError(str(exc), where=surface.source or None) from None
-    except native.MeshingError as exc:
+    except lib.MeshingError as exc:
         if getattr(exc, "code", "") == "cancelled":
             raise Cancelled("cancelled: no mesh was made") from None
         raise InternalError(
@@ -54,10 +56,10 @@ def _checked(reference, mesh, what, source=None):
     return report
 
 
-def _native():
+def native():
     """The compiled core, with a message that says how to build it when it is missing."""
     try:
-        from . import _bsptet
+        from .. import _bsptet
     except ImportError as exc:  # pragma: no cover - depends on the build
         raise InternalError(
             "the C++ core FemBspTet._bsptet is not built or does not load "
@@ -68,7 +70,7 @@ def _native():
 
 def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_quality=True):
     """Checks ``mesh`` against the closed surface it should fill, exactly. Returns a dict."""
-    return _native().check_mesh(
+    return native().check_mesh(
         surface.points,
         surface.triangles,
         mesh.points,
@@ -92,16 +94,16 @@ def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000, sel
     ``merged_points``). Raises :class:`InputError` (``code`` names the kind of problem; the
     message names the triangle, edge or vertex), :class:`SelfIntersectionError` with the pairs.
     """
-    native = _native()
+    lib = native()
     where = surface.source or None
     try:
         with _self_intersection_errors(surface):
-            tri, info = native.check_surface(surface.points, surface.triangles, reorient=bool(reorient),
+            tri, info = lib.check_surface(surface.points, surface.triangles, reorient=bool(reorient),
                                              self_intersections=bool(self_intersections),
                                              max_reported_pairs=int(max_reported_pairs))
     except SelfIntersectionError:
         raise
-    except native.InputError as exc:
+    except lib.InputError as exc:
         raise InputError(str(exc), where=where, code=getattr(exc, "code", None)) from None
     except ValueError as exc:  # array shapes or indices beyond 32 bits (the binding's checks)
         raise InputError(str(exc), where=where, code="bad_argument") from None
@@ -114,10 +116,10 @@ def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000, sel
 @contextlib.contextmanager
 def _self_intersection_errors(surface: Surface):
     """The native self-intersection error (an InputError with ``pairs``) as SelfIntersectionError."""
-    native = _native()
+    lib = native()
     try:
         yield
-    except native.InputError as exc:
+    except lib.InputError as exc:
         if getattr(exc, "code", "") != "self_intersection":
             raise
         raise SelfIntersectionError(str(exc), where=surface.source or None, pairs=np.asarray(exc.pairs),
@@ -126,7 +128,7 @@ def _self_intersection_errors(surface: Surface):
 
 def tet_quality(mesh: TetMesh):
     """Dihedral angles (degrees) and radius-edge ratios of the linear tets of ``mesh``."""
-    return _native().tet_quality(mesh.points, mesh.tets)
+    return native().tet_quality(mesh.points, mesh.tets)
 
 
 def certify_tet10(mesh: TetMesh, max_depth=6, scaled_jacobian=False):
@@ -137,13 +139,13 @@ def certify_tet10(mesh: TetMesh, max_depth=6, scaled_jacobian=False):
     ``undecided`` (treat as invalid); ``status`` (m,) int8 (0, 1, 2 in that order); ``min_bound``
     (m,); with ``scaled_jacobian``, ``min_scaled_jacobian`` (m,): min det J over det J of the
     straight tet, a lower bound within 1e-3. Raises ValueError unless tets has shape (m, 10)."""
-    return _native().tet10_certify(mesh.points, mesh.tets, max_depth=max_depth,
+    return native().tet10_certify(mesh.points, mesh.tets, max_depth=max_depth,
                                    scaled_jacobian=scaled_jacobian)
 
 
 def orient3d(a, b, c, d) -> int:
     """Exact sign of det[b-a, c-a, d-a] (+1: d on the side of the right-hand normal of a, b, c)."""
-    return _native().orient3d(tuple(map(float, a)), tuple(map(float, b)), tuple(map(float, c)),
+    return native().orient3d(tuple(map(float, a)), tuple(map(float, b)), tuple(map(float, c)),
                               tuple(map(float, d)))
 
 
@@ -169,7 +171,6 @@ def to_second_order(mesh: TetMesh) -> TetMesh:
 
 def _effort(options):
     """The ``steiner_effort`` keyword for the native call (absent: the core's default)."""
-    from .errors import InputError
 
     effort = options.get("steiner_effort")
     if effort is None:
@@ -182,10 +183,9 @@ def _effort(options):
 BSP_SEEDS = ("auto", "delaunay", "box")
 
 
-def _native_core_options(options):
+def native_core_options(options):
     """Keywords for the native ``tetrahedralize``: ``steiner_effort`` and ``bsp_seed`` (absent:
     the core's defaults)."""
-    from .errors import InputError
 
     kw = _effort(options)
     seed = options.get("bsp_seed")
@@ -225,7 +225,6 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     returned; ``stats`` holds the core's figures (see ``cli.STATS_KEYS``) and the checker's quality.
     Raises ``InputError`` (bad surface; the message names the triangle) or ``InternalError``.
     """
-    from .errors import InputError
 
     options = dict(options or {})
     unknown = set(options) - set(OPTION_NAMES)
@@ -239,7 +238,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     refining = any(options.get(k) is not None for k in REFINE_OPTIONS
                    if k not in ("order", "projection", "separate_face_tags", "thickness_ratio"))
     separating = bool(options.get("separate_face_tags"))
-    native = _native()
+    lib = native()
     reorient = bool(options.get("reorient", False))
     # Every surface is checked before any is meshed, all but the self-intersection search, which
     # runs beside the core on a second thread (the native check_and_tetrahedralize) when its
@@ -253,7 +252,6 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     originals = [original for original, _ in checked]
     surfaces = [surface for _, surface in checked]
     if options.get("max_memory") is not None:
-        from .memory_budget import require_within_budget
 
         require_within_budget(surfaces, int(options["max_memory"]))
     meshes, all_stats = [], []
@@ -264,12 +262,12 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             if progress is not None:
                 progress(label + stage, fraction)
 
-        with _core_errors(surface, "mesher"), _self_intersection_errors(originals[k]):
-            points, tets, st = native.tetrahedralize(
+        with core_errors(surface, "mesher"), _self_intersection_errors(originals[k]):
+            points, tets, st = lib.tetrahedralize(
                 originals[k].points, originals[k].triangles,
                 allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
                 progress=report, cancel=cancel, check={"reorient": reorient},
-                **_native_core_options(options))
+                **native_core_options(options))
         mesh = TetMesh(points, tets, surface.source)
         report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):
@@ -291,8 +289,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
             st["quality"] = report_check["quality"]
         meshes.append(mesh)
         all_stats.append(st)
-    mesh = _concatenate(meshes)
-    stats = _merge_stats(all_stats)
+    mesh = concatenate_meshes(meshes)
+    stats = merge_stats(all_stats)
     stats["order"] = order
     stats["nodes"] = int(len(mesh.points))
     stats["valid"] = True
@@ -320,111 +318,7 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     return mesh, stats
 
 
-#: What the out-of-core mode holds besides the core's run on one piece (bytes per input triangle):
-#: the input surface, its pieces' triangle lists, and the finished mesh read back for writing.
-OUT_OF_CORE_HOLD_PER_TRIANGLE = 256
-
-
-def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None, cancel=None):
-    """Meshes like :func:`tetrahedralize`, in pieces small enough for ``max_memory`` bytes: the
-    out-of-core mode (``cpp_module/include/bsptet/out_of_core.h``; the paper's Sec. 4.3 swaps
-    finished cells to disk, this core's peak being in its seed instead the solid is cut).
-
-    Each solid is cut into pieces along caps inside it made of its own vertices and points of
-    their own (so the pieces meet exactly and the caps' points are interior Steiner points of the
-    mesh), each piece is meshed by the core alone, checked exactly against its own surface (which
-    checks the whole mesh, piece by piece) and written to disk, then the pieces are streamed into
-    one file and read back. The piece size comes from the budget (``piece_triangles_for_budget``,
-    after what the run holds besides: ``OUT_OF_CORE_HOLD_PER_TRIANGLE`` bytes per triangle).
-
-    ``options``: ``steiner_effort``, ``bsp_seed``, ``reorient`` as for :func:`tetrahedralize`;
-    the quality options, ``order`` 2 and ``allow_boundary_steiner`` are refused (the core's mesh
-    only). Returns ``(TetMesh, stats)``; ``stats["out_of_core"]`` holds the pieces' figures.
-    """
-    import os
-    import tempfile
-
-    from .errors import MemoryBudgetError
-    from .memory_budget import BASE_BYTES, format_bytes
-    from .volume_io import read_tetgen
-
-    options = dict(options or {})
-    unknown = set(options) - set(OPTION_NAMES)
-    if unknown:
-        raise InputError(f"unknown mesher option(s): {', '.join(sorted(unknown))}")
-    refused = sorted(k for k, v in options.items()
-                     if v not in (None, False) and (k in REFINE_OPTIONS and not (k == "order" and int(v) == 1)
-                                                    or k == "allow_boundary_steiner"))
-    if refused:
-        raise InputError("the out-of-core mode makes the core's mesh only: drop "
-                         + ", ".join(refused) + " (or mesh in memory, without --out-of-core)")
-    if max_memory is None:
-        raise InputError("the out-of-core mode needs a memory budget (--max-memory SIZE): the "
-                         "memory available could not be read")
-    if isinstance(surfaces, Surface):
-        surfaces = [surfaces]
-    native = _native()
-    reorient = bool(options.get("reorient", False))
-    checked, flipped = [], 0
-    for surface in surfaces:
-        checked_surface, info = check_surface(surface, reorient=reorient)
-        checked.append(checked_surface)
-        flipped += info["flipped_triangles"]
-    total = sum(len(s.triangles) for s in checked)
-    usable = int(max_memory) - BASE_BYTES - OUT_OF_CORE_HOLD_PER_TRIANGLE * total
-    piece = native.piece_triangles_for_budget(usable) if usable > 0 else 0
-    if usable <= 0 or native.piece_triangles_for_budget(1) > piece:
-        raise MemoryBudgetError(
-            f"a memory budget of {format_bytes(max_memory)} is too small even for the out-of-core "
-            f"mode on {total} triangles (it holds about {format_bytes(OUT_OF_CORE_HOLD_PER_TRIANGLE * total + BASE_BYTES)} "
-            "besides the pieces); raise --max-memory", where=checked[0].source or None,
-            estimate=OUT_OF_CORE_HOLD_PER_TRIANGLE * total + BASE_BYTES, budget=int(max_memory))
-    meshes, all_stats = [], []
-    with tempfile.TemporaryDirectory(prefix="fembsptet_pieces_") as scratch:
-        for k, surface in enumerate(checked):
-            label = f"solid {k + 1} of {len(checked)}: " if len(checked) > 1 else ""
-
-            def report(stage, fraction, label=label):
-                if progress is not None:
-                    progress(label + stage, fraction)
-
-            stem = os.path.join(scratch, f"solid{k}")
-            with _core_errors(surface, "out-of-core mesher"):
-                pieces = native.tetrahedralize_in_pieces(
-                    surface.points, surface.triangles, stem, piece, progress=report, cancel=cancel,
-                    **_native_core_options(options))
-            mesh = read_tetgen(stem)
-            os.remove(stem + ".node")
-            os.remove(stem + ".ele")
-            mesh = TetMesh(mesh.points, mesh.tets, surface.source)
-            n_input = len(np.unique(surface.triangles))
-            st = {"input_points": int(len(surface.points)), "input_triangles": int(len(surface.triangles)),
-                  "points": int(pieces["points"]), "tets": int(pieces["tets"]),
-                  "steiner_points": int(pieces["points"]) - n_input, "boundary_steiner_points": 0,
-                  "interior_steiner_points": int(pieces["points"]) - n_input,
-                  "quality": tet_quality(mesh), "out_of_core": dict(pieces)}
-            meshes.append(mesh)
-            all_stats.append(st)
-    out_of_core = [st.pop("out_of_core") for st in all_stats]
-    mesh = _concatenate(meshes)
-    stats = _merge_stats(all_stats)
-    stats["out_of_core"] = out_of_core[0] if len(out_of_core) == 1 else out_of_core
-    stats["order"] = 1
-    stats["nodes"] = int(len(mesh.points))
-    stats["valid"] = True  # every piece was checked exactly (tetrahedralize_in_pieces)
-    stats["flipped_triangles"] = flipped
-    notes = [f"meshed out of core: {sum(p['pieces'] for p in out_of_core)} pieces of at most "
-             f"{piece} triangles; {sum(p['cap_points'] for p in out_of_core)} of the Steiner points "
-             "are the caps' own points, inside the solid"]
-    if flipped:
-        notes.append(f"re-oriented {flipped} triangle(s) (--reorient)")
-    for p in out_of_core:
-        notes.extend(p["uncut"])
-    stats["notes"] = notes
-    return mesh, stats
-
-
-def _concatenate(meshes):
+def concatenate_meshes(meshes):
     if len(meshes) == 1:
         return meshes[0]
     offsets = np.cumsum([0] + [len(m.points) for m in meshes[:-1]])
@@ -433,7 +327,7 @@ def _concatenate(meshes):
                    " + ".join(m.source for m in meshes if m.source))
 
 
-def _merge_stats(all_stats):
+def merge_stats(all_stats):
     out = {}
     for st in all_stats:
         for k, v in st.items():
@@ -470,7 +364,6 @@ def _merge_stats(all_stats):
 
 
 def _version():
-    from . import __version__
 
     return __version__
 
@@ -516,7 +409,6 @@ OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "bsp_seed", "order",
 
 
 def _positive_number(name, value, allow_zero=False):
-    from .errors import InputError
 
     try:
         v = float(value)
@@ -539,7 +431,6 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     conforming faces, closed boundary; the boundary then is the refined, projected surface).
     Raises ``InputError`` for bad options, ``InternalError`` otherwise.
     """
-    from .errors import InputError
 
     options = dict(options or {})
     unknown = set(options) - set(REFINE_OPTIONS)
@@ -571,9 +462,9 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
         raise InputError("projection must be a callable (point, tag, other_tag) -> point")
     only_order = (set(k for k, v in options.items() if v is not None)
                   <= {"order", "projection", "separate_face_tags", "thickness_ratio"})
-    native = _native()
-    with _core_errors(surface, "refinement"):
-        points, tets, st = native.refine(
+    lib = native()
+    with core_errors(surface, "refinement"):
+        points, tets, st = lib.refine(
             surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
             size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
             min_dihedral=min_dihedral, order=order, surface_points_mode=mode,

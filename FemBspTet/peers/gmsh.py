@@ -5,7 +5,7 @@
 coordinates with round-trip precision) and a ``.geo`` that merges it, closes it into a volume
 (``Surface Loop`` + ``Volume``) and sets ``Mesh.CharacteristicLengthMax = size``; then runs
 ``gmsh <name>.geo -3 -nt 1 -format msh22`` and reads the tets back with our own reader
-(:func:`FemBspTet.volume_io.read_tet_mesh`).
+(:func:`FemBspTet.io.volume_io.read_tet_mesh`).
 
 Two ways, as TetGen's ``-pY`` and ``-pq``:
 
@@ -32,8 +32,9 @@ import tempfile
 
 import numpy as np
 
-from ..errors import InternalError
-from ..mesh_types import Surface, TetMesh
+from ..io.volume_io import read_tet_mesh
+from ..kernel.errors import InternalError
+from ..kernel.mesh_types import Surface, TetMesh
 from .process import run_measured
 
 
@@ -135,7 +136,6 @@ def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None, name="s
     exe = gmsh_path()
     if exe is None:
         raise InternalError("gmsh is not installed (Debian package gmsh); run scripts/setup.sh")
-    from ..volume_io import read_tet_mesh
 
     workdir = keep_dir or tempfile.mkdtemp(prefix="fembsptet_gmsh_")
     try:

@@ -21,11 +21,13 @@ Needs FreeCAD (Debian freecad-python3), ``ccx`` and ``gmsh`` on PATH.
 import math
 import os
 
-from ..errors import InternalError
+from ..kernel.errors import InternalError
+from ..kernel.paths import RESOURCES_DIR
+from .mesher_object import make_mesher
+from .mesher_tools import run_mesher
 
 #: The sample part of the ``bracket`` case.
-BRACKET_STEP = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-    os.path.abspath(__file__)))), "resources", "samples", "bracket.step")
+BRACKET_STEP = os.path.join(RESOURCES_DIR, "samples", "bracket.step")
 
 #: Steel, as in freecad.md §6.
 YOUNGS_MODULUS = "210000 MPa"
@@ -116,8 +118,6 @@ def hole_face_name(shape):
 
 def add_bsptet_mesh(case, max_size, order, **properties):
     """Our mesher object for the case's part, meshed (run_mesher) and added to the analysis."""
-    from ..mesher_object import make_mesher
-    from ..mesher_tools import run_mesher
 
     obj = make_mesher(case.doc, case.part, CharacteristicLengthMax=max_size,
                       ElementOrder="2nd" if order == 2 else "1st", CompareWithTetGen=False,

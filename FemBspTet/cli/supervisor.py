@@ -3,7 +3,7 @@
 process when a time or memory limit asks for one (:func:`run_supervised`), else in this process
 (:func:`run_interruptible`: Ctrl-C and SIGTERM only).
 
-    from FemBspTet.supervisor import Limits, run_supervised
+    from FemBspTet.cli.supervisor import Limits, run_supervised
     code = run_supervised(job, Limits(timeout=60, max_memory=4 << 30), outputs=["out.vtu"])
 
 Why a child process: the core checks for cancellation between steps, but some steps (and
@@ -34,8 +34,9 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
+import traceback
 
-from .errors import Cancelled, InternalError, MemoryBudgetError, TimeLimitReached
+from ..kernel.errors import Cancelled, InternalError, MemoryBudgetError, TimeLimitReached
 
 __all__ = ["Limits", "run_supervised", "run_interruptible", "child_rss_bytes",
            "remove_temporaries"]
@@ -104,7 +105,6 @@ def _run_child(job):
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else 1
     except BaseException:  # noqa: BLE001 - the job reports its own errors; this is the last resort
-        import traceback
 
         traceback.print_exc()
         code = 1

@@ -23,7 +23,7 @@ import os
 import numpy as np
 
 from .atomic_file import atomic_output
-from .mesh_types import TetMesh
+from ..kernel.mesh_types import TetMesh
 
 #: corners of the four faces of a tet, outward for a positively oriented tet
 _FACES = ((1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1))

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Memory budget of a meshing run: an estimate before it starts, sizes as people write them.
 
-    from FemBspTet.memory_budget import estimate_peak_bytes, parse_size, require_within_budget
+    from FemBspTet.kernel.memory_budget import estimate_peak_bytes, parse_size, require_within_budget
     budget = parse_size("4G")                         # 4 * 2**30 bytes
     require_within_budget(surfaces, budget)           # MemoryBudgetError if the estimate exceeds it
 
@@ -10,7 +10,7 @@ The estimate is the typical peak with margin: about 1 to 3 KiB per input triangl
 interpreter's share. The BSP's size depends on the geometry, not only on the counts (inputs
 whose triangles cross many seed tets reach tens of KiB per triangle), so it is only a first
 filter: the supervised CLI also watches the run's real resident memory against the same budget
-(:mod:`FemBspTet.supervisor`) and stops it if it goes over. An envelope over those worst cases
+(:mod:`FemBspTet.cli.supervisor`) and stops it if it goes over. An envelope over those worst cases
 (80 KiB per triangle) would refuse every input above a few 10^5 triangles on a 24 GiB
 machine, although 10^6 triangles take about 1 GiB.
 """

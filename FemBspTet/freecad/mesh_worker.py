@@ -11,7 +11,7 @@ Client side (GUI thread, or any script)::
     result = job.result()                  # MeshResult, or raises the worker's error
     job.cancel()                           # at any time: kills the worker, nothing is kept
 
-Worker side: ``<python> -m FemBspTet.mesh_worker JOB_DIR`` with the checkout on PYTHONPATH.
+Worker side: ``<python> -m FemBspTet.freecad.mesh_worker JOB_DIR`` with the checkout on PYTHONPATH.
 
 Job directory protocol (a private temporary directory, removed by the client):
 
@@ -41,19 +41,12 @@ import tempfile
 import threading
 import traceback
 
-from .errors import InputError, InternalError, MeshingCancelled
+from ..compare.comparison import tetgen_comparison_of
+from ..fem.mesh_pipeline import mesh_brep, MeshParameters, MeshResult
+from ..kernel.errors import InputError, InternalError, MeshingCancelled
+from ..peers.process import worker_env
+from .preferences import worker_python
 
-#: The checkout (the directory that holds the FemBspTet package).
-CHECKOUT_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-def worker_env():
-    """Environment of a worker interpreter: this checkout first on its PYTHONPATH, and no
-    PYTHONHOME (FreeCAD's own, if any, is not the worker's)."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = CHECKOUT_DIR + (os.pathsep + env["PYTHONPATH"]
-                                        if env.get("PYTHONPATH") else "")
-    env.pop("PYTHONHOME", None)
-    return env
 
 
 _ERROR_TYPES = {"InputError": InputError, "InternalError": InternalError,
@@ -71,7 +64,6 @@ def write_job(job_dir, shape, params, source=""):
 
 def read_result(job_dir):
     """The MeshResult of a finished job, or raise the error the worker reported."""
-    from .mesh_pipeline import MeshResult
 
     err = os.path.join(job_dir, "error.json")
     if os.path.isfile(err):
@@ -102,10 +94,9 @@ class MeshJob:
     def command(self):
         """``(argv, env)`` of the worker process."""
         if self._python is None:
-            from .preferences import worker_python
 
             self._python = worker_python()
-        return [self._python, "-m", "FemBspTet.mesh_worker", self._dir], worker_env()
+        return [self._python, "-m", "FemBspTet.freecad.mesh_worker", self._dir], worker_env()
 
     def start(self):
         if self._proc is not None:
@@ -202,7 +193,7 @@ def main(argv=None):
     """Worker entry point: mesh the job in ``argv[0]``; see the module docstring."""
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) != 1:
-        print("usage: python3 -m FemBspTet.mesh_worker JOB_DIR", file=sys.stderr)
+        print("usage: python3 -m FemBspTet.freecad.mesh_worker JOB_DIR", file=sys.stderr)
         return 2
     job_dir = argv[0]
 
@@ -212,7 +203,6 @@ def main(argv=None):
         sys.stdout.flush()
 
     try:
-        from .mesh_pipeline import MeshParameters, mesh_brep
 
         with open(os.path.join(job_dir, "parameters.json"), encoding="utf-8") as f:
             job = json.load(f)
@@ -220,7 +210,7 @@ def main(argv=None):
         with open(os.path.join(job_dir, "shape.brep"), encoding="utf-8") as f:
             brep = f.read()
         result = mesh_brep(brep, job["face_count"], params, progress=progress,
-                           source=job.get("source", ""))
+                           source=job.get("source", ""), tetgen_row=tetgen_comparison_of)
         result.save(os.path.join(job_dir, "result.npz"), os.path.join(job_dir, "result.json"))
         return 0
     except Exception as e:  # reported to the client through error.json

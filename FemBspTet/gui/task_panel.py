@@ -3,7 +3,7 @@
 and the TetGen comparison table.
 
 * Apply writes the parameters to the object and meshes in a worker process
-  (:class:`FemBspTet.mesh_worker.MeshJob`): the GUI thread only polls it from a QTimer, so
+  (:class:`FemBspTet.freecad.mesh_worker.MeshJob`): the GUI thread only polls it from a QTimer, so
   FreeCAD never freezes, and a crash of the core cannot take FreeCAD down.
 * Stop (or the dialog's Cancel) kills the worker at once; nothing of that run is kept.
 * A failed run keeps the previous mesh and the document; the error goes to the report view and
@@ -12,7 +12,13 @@ and the TetGen comparison table.
 * OK writes the parameters and closes; it is refused while a run is going (Stop it first).
 """
 
-from .errors import BspTetError, MeshingCancelled
+import time
+
+from ..compare.comparison import COLUMNS, OURS, Row, TETGEN_PY
+from ..freecad.mesh_worker import MeshJob
+from ..freecad.mesher_object import ROW_PROPERTIES
+from ..freecad.mesher_tools import apply_result, parameters_from_object, record_failure, shape_of
+from ..kernel.errors import BspTetError, InternalError, MeshingCancelled
 
 #: Fields of the comparison rows the table shows (``compare.comparison.COLUMNS``; the values
 #: come from the object's result properties, ``mesher_object.ROW_PROPERTIES``).
@@ -83,7 +89,6 @@ class TaskPanelMeshBspTet:
         self.stats = QtGui.QLabel("")
         self.stats.setWordWrap(True)
         self.stats.setTextInteractionFlags(self.stats.textInteractionFlags() | 1)
-        from .compare.comparison import COLUMNS
 
         headers = dict((key, head) for key, head, _fmt in COLUMNS)
         self.table = QtGui.QTableWidget(len(TABLE_FIELDS), 2)
@@ -177,8 +182,6 @@ class TaskPanelMeshBspTet:
         """Write the parameters and start a worker. Returns False if it could not start."""
         import FreeCAD
 
-        from .mesh_worker import MeshJob
-        from .mesher_tools import parameters_from_object, record_failure, shape_of
 
         if self.running:
             self.status.setText("Meshing is already running.")
@@ -239,7 +242,6 @@ class TaskPanelMeshBspTet:
         try:
             result = job.result()
         except Exception as e:  # the worker's error, or unreadable result files
-            from .mesher_tools import record_failure
 
             e = _as_bsptet_error(e)
             record_failure(self.obj, e)
@@ -250,7 +252,6 @@ class TaskPanelMeshBspTet:
 
     def wait(self, timeout=None):
         """Block until the running job ends, processing its events (scripts and tests)."""
-        import time
 
         from PySide import QtGui
 
@@ -266,7 +267,6 @@ class TaskPanelMeshBspTet:
     def _apply(self, result):
         import FreeCAD
 
-        from .mesher_tools import apply_result
 
         doc = self.obj.Document
         doc.openTransaction("Mesh with BspTet")
@@ -331,8 +331,6 @@ class TaskPanelMeshBspTet:
 def object_rows(obj):
     """``(ours, tetgen)``: comparison rows (``compare.comparison.Row``) rebuilt from the
     object's result properties, or None for a side without a mesh."""
-    from .compare.comparison import OURS, TETGEN_PY, Row
-    from .mesher_object import ROW_PROPERTIES
 
     rows = []
     for mesher, present in ((OURS, obj.Nodes > 0), (TETGEN_PY, obj.TetGenTetrahedra > 0)):
@@ -353,6 +351,5 @@ def _as_bsptet_error(error):
     """``error`` itself if it is one of ours, else an InternalError that names it."""
     if isinstance(error, BspTetError):
         return error
-    from .errors import InternalError
 
     return InternalError("unexpected %s: %s" % (type(error).__name__, error))

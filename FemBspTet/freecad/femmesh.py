@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Convert between :class:`~FemBspTet.mesh_types.TetMesh` and FreeCAD's ``Fem.FemMesh``, and write
+"""Convert between :class:`~FemBspTet.kernel.mesh_types.TetMesh` and FreeCAD's ``Fem.FemMesh``, and write
 or read mesh files through FreeCAD's own writers and readers.
 
 Conventions (FreeCAD 0.20.2's FemMesh, SMESH underneath):
@@ -32,8 +32,10 @@ import tempfile
 
 import numpy as np
 
-from .errors import InputError, InternalError
-from .mesh_types import TetMesh
+from ..io.volume_io import _checked_groups
+from ..kernel.errors import InputError, InternalError
+from ..kernel.freecad_env import import_freecad
+from ..kernel.mesh_types import TetMesh
 
 #: Our corner order -> SMESH corner order (swap n1, n2). Its own inverse.
 TET4_SWAP = (1, 0, 2, 3)
@@ -73,7 +75,7 @@ def tetmesh_to_femmesh(mesh, groups=None, group_prefix=""):
     """Build a ``Fem.FemMesh`` (SMESH orientation, 1-based ids) from a positively oriented TetMesh.
 
     mesh:         :class:`TetMesh` with (m, 4) or (m, 10) tets, positively oriented.
-    groups:       optional :class:`~FemBspTet.mesh_types.MeshGroups`: the CAD faces' triangles
+    groups:       optional :class:`~FemBspTet.kernel.mesh_types.MeshGroups`: the CAD faces' triangles
                   become FemMesh faces (tria3, or tria6 for tet10; ids m + 1, m + 2, ...), and
                   each CAD face a "Face" group of them and a "Node" group of their nodes, each
                   solid (if ``groups.tet_solid`` is given) a "Volume" group, named
@@ -85,7 +87,6 @@ def tetmesh_to_femmesh(mesh, groups=None, group_prefix=""):
     Raises InputError for non-finite coordinates, out-of-range node indices, or tets that are
     not positively oriented (zero or negative volume; the message names the first one).
     """
-    from .freecad_env import import_freecad
 
     import_freecad()
     import Fem
@@ -144,7 +145,6 @@ def _fill_femmesh(fem, mesh, groups=None, group_prefix=""):
 
 def _add_groups(fem, mesh, groups, prefix):
     """The faces and groups of :func:`tetmesh_to_femmesh`."""
-    from .volume_io import _checked_groups
 
     sets = _checked_groups(mesh.source or "mesh", groups, mesh.points, mesh.tets)
     m = len(mesh.tets)
@@ -306,7 +306,6 @@ def read_via_freecad(path):
     Raises InputError for a missing file, an unsupported extension, a file FreeCAD cannot
     read, or a mesh that is not made of consistently oriented tetrahedra.
     """
-    from .freecad_env import import_freecad
 
     path = os.fspath(path)
     ext = _format_of(path)

@@ -8,12 +8,17 @@
 
 A failed run leaves the object's previous ``FemMesh`` as it was; only ``MeshStatus`` says what
 went wrong. The task panel runs the same pipeline in a worker process
-(:mod:`FemBspTet.mesh_worker`) and hands the result to :func:`apply_result` on the GUI thread.
+(:mod:`FemBspTet.freecad.mesh_worker`) and hands the result to :func:`apply_result` on the GUI thread.
 """
 
-from .errors import InputError
-from .mesh_pipeline import (PROPERTY_OF, REMOVED_PARAMETERS, MeshParameters, mesh_cad_shape,
-                            removed_parameter_message)
+import os
+
+from ..compare.comparison import tetgen_comparison_of
+from ..fem.mesh_pipeline import (FACE_GROUP_PREFIX, mesh_cad_shape, MeshParameters, PROPERTY_OF,
+                                 removed_parameter_message, REMOVED_PARAMETERS)
+from ..kernel.errors import InputError
+from .femmesh import tetmesh_to_femmesh, write_femmesh
+from .mesher_object import RESULT_PROPERTIES, ROW_PROPERTIES
 
 #: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
 EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
@@ -52,6 +57,7 @@ def run_mesher(obj, progress=None, cancel=None):
     try:
         params = parameters_from_object(obj)
         result = mesh_cad_shape(shape_of(obj), params, progress=progress, cancel=cancel,
+                                tetgen_row=tetgen_comparison_of,
                                 source=obj.Label)
     except Exception as e:  # every failure is recorded; the error itself goes on up
         record_failure(obj, e)
@@ -68,8 +74,6 @@ def record_failure(obj, error):
 def femmesh_of(result, face_groups):
     """The ``Fem.FemMesh`` of a MeshResult (SMESH conventions; if ``face_groups``, the boundary
     triangles as faces and per CAD face a face group and a node group ``BspTet_Face<k>``)."""
-    from .freecad_export import tetmesh_to_femmesh
-    from .mesh_pipeline import FACE_GROUP_PREFIX
 
     return tetmesh_to_femmesh(result.mesh, result.groups() if face_groups else None,
                               group_prefix=FACE_GROUP_PREFIX)
@@ -98,7 +102,6 @@ def set_tetgen_properties(obj, row):
     """The TetGen result properties from the comparison's ``tetgen -pY`` row (a dict,
     :func:`FemBspTet.compare.comparison.row_dict`), or cleared when ``row`` is None. A row
     without a mesh leaves the figures 0 and says why in ``TetGenCommand``."""
-    from .mesher_object import ROW_PROPERTIES, RESULT_PROPERTIES
 
     kinds = {name: kind for kind, name, _tip in RESULT_PROPERTIES}
     row = row or {}
@@ -139,7 +142,7 @@ def mesh_shape(shape, **options):
             value = {"1st": 1, "2nd": 2}.get(value, value)
         params[field] = value
     params = MeshParameters.from_dict(params)
-    result = mesh_cad_shape(shape, params)
+    result = mesh_cad_shape(shape, params, tetgen_row=tetgen_comparison_of)
     return femmesh_of(result, params.face_groups)
 
 
@@ -147,9 +150,7 @@ def export_mesh(obj, path):
     """Write the mesh of ``obj`` (any FEM mesh object) to ``path`` with FreeCAD's writer for its
     extension: .inp (CalculiX C3D4/C3D10), .unv, .vtk, .vtu, .med, .z88. Returns the path.
     Written to a temporary file and renamed: a failure leaves no partial file."""
-    import os
 
-    from .freecad_export import write_femmesh
 
     ext = os.path.splitext(os.fspath(path))[1].lower()
     if ext not in EXPORT_FORMATS:

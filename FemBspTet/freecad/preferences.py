@@ -32,6 +32,6 @@ def object_defaults():
 
 
 def worker_python():
-    """The interpreter that runs :mod:`FemBspTet.mesh_worker` (preference ``WorkerPython``)."""
+    """The interpreter that runs :mod:`FemBspTet.freecad.mesh_worker` (preference ``WorkerPython``)."""
     path = _group().GetString("WorkerPython", "").strip()
     return path or DEFAULT_WORKER_PYTHON

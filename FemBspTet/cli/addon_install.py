@@ -12,10 +12,9 @@ code as the ``fembsptet`` command.
 import glob
 import os
 
-from .errors import InputError
+from ..kernel.errors import InputError
+from ..kernel.paths import ADDON_DIR
 
-#: The addon folder: the one holding Init.py, InitGui.py, package.xml and the FemBspTet package.
-ADDON_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LINK_NAME = "FemBspTet"
 
 

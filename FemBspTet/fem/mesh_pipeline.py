@@ -6,8 +6,8 @@ around it, without any document object.
     params = MeshParameters(max_size=500.0, order=2)
     result = mesh_cad_shape(shape, params, progress=None, cancel=None)    # -> MeshResult
 
-Used in-process by ``run_mesher`` / ``mesh_shape`` (:mod:`FemBspTet.mesher_tools`) and in the
-worker process of the task panel (:mod:`FemBspTet.mesh_worker`, which meshes the BREP text with
+Used in-process by ``run_mesher`` / ``mesh_shape`` (:mod:`FemBspTet.freecad.mesher_tools`) and in the
+worker process of the task panel (:mod:`FemBspTet.freecad.mesh_worker`, which meshes the BREP text with
 :func:`mesh_brep` and needs FreeCAD only for the TetGen comparison).
 
 Stages:
@@ -22,7 +22,7 @@ Stages:
 2. The boundary triangles keep the CAD face they lie on (0-based: FreeCAD's ``Face<k+1>``); the
    tet10 boundary mid-nodes are read off the tets. They give the node groups per CAD face and
    what FreeCAD's constraints find.
-3. Quality figures of the linear tets (:func:`FemBspTet.core.tet_quality`) and notes.
+3. Quality figures of the linear tets (:func:`FemBspTet.kernel.core.tet_quality`) and notes.
 4. Optionally ``tetgen -pY`` on OpenCASCADE's display tessellation of the shape (the comparison
    table of the task panel; our mesh is not made from that tessellation).
 """
@@ -34,8 +34,11 @@ import time
 
 import numpy as np
 
-from .errors import Cancelled, InputError, InternalError, MeshingCancelled
-from .mesh_types import MeshGroups, TetMesh
+from ..kernel import core
+from ..kernel.errors import Cancelled, InputError, InternalError, MeshingCancelled
+from ..kernel.freecad_env import import_freecad
+from ..kernel.mesh_types import MeshGroups, TetMesh
+from .cad_mesh import mesh_cad_brep
 
 #: FreeCAD property name of each MeshParameters field (for messages that name what to change).
 PROPERTY_OF = {
@@ -49,7 +52,7 @@ PROPERTY_OF = {
 #: Parameters of the former tessellation pipeline, by FreeCAD property name: the FEM path meshes
 #: the CAD surface itself, so none of them has a meaning any more. Named in the message that
 #: refuses them (``mesh_shape``, ``make_mesher``); saved documents lose them on opening
-#: (:func:`FemBspTet.mesher_object.add_properties`).
+#: (:func:`FemBspTet.freecad.mesher_object.add_properties`).
 REMOVED_PARAMETERS = {
     "linear_deflection": "LinearDeflection",
     "angular_deflection": "AngularDeflection",
@@ -188,7 +191,7 @@ class MeshResult:
 
     def groups(self):
         """The boundary triangles (with their mid-nodes) per CAD face as
-        :class:`~FemBspTet.mesh_types.MeshGroups` (no solid numbers: the tets' solids are not
+        :class:`~FemBspTet.kernel.mesh_types.MeshGroups` (no solid numbers: the tets' solids are not
         kept)."""
         tri = self.boundary_faces
         if len(self.boundary_midnodes):
@@ -232,12 +235,13 @@ def _json_default(value):
 # the pipeline
 # ------------------------------------------------------------------------------------------
 
-def mesh_cad_shape(shape, params, progress=None, cancel=None, source=""):
+def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", tetgen_row=None):
     """Mesh every solid of ``shape`` (a ``Part.Shape``) with ``params``; see the module docstring.
 
     progress: ``progress(stage, fraction)`` (fraction in [0, 1] or None), called now and then.
     cancel:   ``cancel()`` returning True stops the run with MeshingCancelled.
     source:   a name for messages (the document object's label, a file name).
+    tetgen_row: the TetGen comparison (see :func:`mesh_brep`), run if ``params.compare_tetgen``.
 
     Returns a :class:`MeshResult`. Raises InputError (no solid, a bad parameter, a part the
     surface mesher cannot mesh: the message names the CAD face or solid), MeshingCancelled, or
@@ -250,15 +254,16 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source=""):
     if shape.isNull():
         raise InputError("the shape is empty: nothing to mesh", where=where)
     return mesh_brep(shape.exportBrepToString(), len(shape.Faces), params, progress=progress,
-                     cancel=cancel, source=source, shape=shape)
+                     cancel=cancel, source=source, shape=shape, tetgen_row=tetgen_row)
 
 
-def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", shape=None):
+def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", shape=None,
+              tetgen_row=None):
     """:func:`mesh_cad_shape` on the shape's BREP text ``brep`` (``Shape.exportBrepToString``)
-    with ``face_count`` faces. Needs FreeCAD only for the TetGen comparison (``shape``: the
-    ``Part.Shape`` for it; read from ``brep`` when None)."""
-    from . import core
-    from .fem.cad_mesh import mesh_cad_brep
+    with ``face_count`` faces. With ``params.compare_tetgen``, ``tetgen_row(shape, max_size,
+    source)`` (FemBspTet.compare.comparison.tetgen_comparison_of, passed by the FreeCAD layer)
+    gives the TetGen comparison's row; it needs FreeCAD (``shape``: the ``Part.Shape`` for it;
+    read from ``brep`` when None)."""
 
     params = _validated(params)
     t_start = time.perf_counter()
@@ -315,10 +320,10 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
         raise MeshingCancelled("cancelled: no mesh was made")
 
     tetgen = None
-    if params.compare_tetgen:
+    if params.compare_tetgen and tetgen_row is not None:
         report("tetgen -%s on OpenCASCADE's tessellation" % TETGEN_SWITCHES, 0.92)
-        tetgen = tetgen_comparison_of(shape if shape is not None else _shape_of_brep(brep),
-                                      params.max_size, source)
+        tetgen = tetgen_row(shape if shape is not None else _shape_of_brep(brep),
+                            params.max_size, source)
     stats["seconds_total"] = time.perf_counter() - t_start
     report("done", 1.0)
     return MeshResult(mesh, faces, tags, midnodes,
@@ -335,7 +340,6 @@ def _validated(params):
 
 
 def _shape_of_brep(brep):
-    from .freecad_env import import_freecad
 
     import_freecad()
     import Part
@@ -343,35 +347,6 @@ def _shape_of_brep(brep):
     shape = Part.Shape()
     shape.importBrepFromString(brep)
     return shape
-
-
-def tetgen_comparison_of(shape, max_size=0.0, source=""):
-    """``tetgen -pY`` on OpenCASCADE's display tessellation of ``shape`` (default deflection for
-    the element size, fins flipped away as ``fembsptet mesh --tessellation`` does): the
-    comparison's row as a dict. A shape OpenCASCADE cannot tessellate into closed surfaces is a
-    row with ``status`` "failed" and the reason (never raises for that)."""
-    from . import cad_tessellation
-    from .compare.comparison import TETGEN_PY, Row, row_dict
-
-    size = max_size if max_size > 0 else None
-    try:
-        surfaces = cad_tessellation.tessellate_shape(
-            shape, cad_tessellation.default_linear_deflection(shape, size), source=source)
-    except InputError as e:
-        return row_dict(Row(mesher=TETGEN_PY, command="tetgen -%s" % TETGEN_SWITCHES,
-                            status="failed",
-                            message="OpenCASCADE's tessellation: %s" % str(e)[:300]))
-    surfaces, _ = cad_tessellation.flip_out_fins_of(surfaces)
-    return run_tetgen_comparison(surfaces)
-
-
-def run_tetgen_comparison(surfaces):
-    """``tetgen -pY`` on the surfaces: the comparison's row (:func:`FemBspTet.compare.comparison.
-    tetgen_pY_row`) as a dict; a missing or failing TetGen is a row with ``status`` and
-    ``message`` (never raises)."""
-    from .compare.comparison import row_dict, tetgen_pY_row
-
-    return row_dict(tetgen_pY_row(surfaces))
 
 
 # ------------------------------------------------------------------------------------------

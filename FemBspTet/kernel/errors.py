@@ -9,7 +9,12 @@ where it can, what to do about it. The CLI maps them to exit codes:
 * :class:`InternalError` -> exit code 1 (our fault, or a feature that does not exist yet)
 * :class:`Cancelled`     -> exit code 130 (Ctrl-C, the task panel's Cancel, a ``cancel()`` callback)
 * :class:`TimeLimitReached` -> exit code 124 (``--timeout``; the same code as coreutils' timeout)
+
+:func:`report_errors` turns them into one message and that exit code.
 """
+
+import sys
+import traceback
 
 
 class BspTetError(Exception):
@@ -79,3 +84,28 @@ class MeshingCancelled(Cancelled):
     """The user stopped a FreeCAD meshing run (Cancel in the task panel, ``cancel()`` returning
     True). No mesh was made; an object's previous mesh is kept. A :class:`Cancelled` like the
     core's own cancellation, so ``except Cancelled`` catches both."""
+
+
+def report_errors(func, args, program="fembsptet"):
+    """Runs ``func(args)`` and returns its exit code; every error becomes one message on stderr
+    (``program: error: ...``) and the exit code of the module doc (2 for bad input and out of
+    memory, 130 for an interrupt, 1 for anything unexpected, with its traceback)."""
+    try:
+        return func(args)
+    except InputError as exc:
+        print(f"{program}: error: {exc}", file=sys.stderr)
+        return 2
+    except BspTetError as exc:
+        print(f"{program}: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"{program}: interrupted; no output was written", file=sys.stderr)
+        return 130
+    except MemoryError:
+        print(f"{program}: error: out of memory; no output was written (set a --max-memory "
+              "budget or mesh a coarser tessellation)", file=sys.stderr)
+        return 2
+    except Exception:  # noqa: BLE001 - last resort: report and exit 1, never a bare traceback
+        print(f"{program}: internal error (please report it with the input):", file=sys.stderr)
+        traceback.print_exc()
+        return 1

@@ -13,9 +13,9 @@
 timed-out mesher is a row that says so). Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
 mesh is not valid, and for a run over its memory budget; 1 internal failure (also a crash of the
 native code); 124 time limit reached (--timeout); 130 interrupted (Ctrl-C, SIGTERM).
-``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.supervisor`): Ctrl-C,
+``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.cli.supervisor`): Ctrl-C,
 --timeout and the memory budget stop it within a fraction of a second, with no partial file.
-Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli``.
+Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli.main``.
 """
 
 import argparse
@@ -24,18 +24,34 @@ import math
 import os
 import sys
 import time
-import traceback
 
 import numpy as np
 
-from . import __version__
-from .errors import BspTetError, InputError, SelfIntersectionError
-from .progress import Progress
+from .. import __version__
+from ..compare.benchmark import model_paths, run_benchmark, write_report
+from ..compare.comparison import (compare, format_rows, format_table, MESHERS, plot_histograms,
+                                  row_from_stats, tetgen_pY_row, write_json)
+from ..fem.cad_check import check_against_cad
+from ..fem.cad_mesh import mesh_cad_file
+from ..freecad.femmesh import read_via_freecad, write_via_freecad
+from ..io.atomic_file import atomic_output
+from ..io.cad_tessellation import tessellate_file
+from ..io.formats import (CAD_EXTENSIONS, extension, FREECAD_VOLUME_EXTENSIONS,
+                          SURFACE_EXTENSIONS, VOLUME_EXTENSIONS)
+from ..io.inputs import load_input
+from ..io.render import render_mesh
+from ..io.surface_io import read_surface, write_surface
+from ..io.volume_io import read_tet_mesh, stored_points, surface_groups, write_tet_mesh
+from ..kernel import core
+from ..kernel.errors import InputError, report_errors, SelfIntersectionError
+from ..kernel.memory_budget import default_budget, parse_size
+from ..kernel.mesh_types import Surface, TetMesh
+from ..kernel.progress import Progress
+from ..peers.process import DEFAULT_TIMEOUT
+from .addon_install import install
+from .supervisor import Limits, run_interruptible, run_supervised
+from ..fem.pieces import tetrahedralize_out_of_core
 
-SURFACE_EXTENSIONS = (".off", ".stl", ".obj", ".ply")
-CAD_EXTENSIONS = (".step", ".stp", ".brep", ".brp", ".iges", ".igs")
-VOLUME_EXTENSIONS = (".vtu", ".msh", ".inp", ".node", ".ele", ".mesh")
-FREECAD_VOLUME_EXTENSIONS = (".unv", ".med", ".z88")
 
 # Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
 STATS_KEYS = (
@@ -59,29 +75,7 @@ STATS_KEYS = (
 )
 
 
-def _ext(path):
-    return os.path.splitext(path)[1].lower()
-
-
-def load_input(path, size=None):
-    """Reads a surface file or tessellates a CAD file (its fins flipped away,
-    :func:`FemBspTet.cad_tessellation.flip_out_fins`). Returns a list of Surfaces (one per solid)."""
-    ext = _ext(path)
-    if ext in SURFACE_EXTENSIONS:
-        from .surface_io import read_surface
-
-        return [read_surface(path)]
-    if ext in CAD_EXTENSIONS:
-        from .cad_tessellation import flip_out_fins_of, tessellate_file
-
-        # OpenCASCADE's fins (near-collinear triangles) flipped inside their faces: every tet
-        # on a fin is flat
-        return flip_out_fins_of(tessellate_file(path, size=size))[0]
-    raise InputError(
-        f"unknown input format '{ext or '(no extension)'}'; supported: "
-        + ", ".join(SURFACE_EXTENSIONS + CAD_EXTENSIONS),
-        where=path,
-    )
+_ext = extension
 
 
 def check_output_path(path):
@@ -102,11 +96,9 @@ def write_output(path, mesh, groups=None):
     """Write ``mesh`` (with its named sets ``groups``, a MeshGroups, when given) to ``path``."""
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
-        from .freecad_export import write_via_freecad
 
         write_via_freecad(path, mesh, groups)
     else:
-        from .volume_io import write_tet_mesh
 
         _check_stored(path, mesh)
         write_tet_mesh(path, mesh, groups)
@@ -116,9 +108,6 @@ def _check_stored(path, mesh):
     """A format that rounds coordinates (``.inp``: CalculiX's 20-character fields) must not
     turn the valid mesh into an invalid one: the mesh as the file will hold it is checked
     exactly (orientation, flat tets, tet10 mid-nodes) before it is written."""
-    from . import core
-    from .mesh_types import TetMesh
-    from .volume_io import stored_points
 
     points = stored_points(path, mesh.points)
     changed = (points != mesh.points).any(axis=1)
@@ -138,11 +127,9 @@ def _check_stored(path, mesh):
 def read_volume(path):
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
-        from .freecad_export import read_via_freecad
 
         return read_via_freecad(path)
     if ext in VOLUME_EXTENSIONS:
-        from .volume_io import read_tet_mesh
 
         return read_tet_mesh(path)
     raise InputError(
@@ -173,7 +160,6 @@ def _check_mesh_args(args):
         parent = os.path.dirname(os.path.abspath(args.write_intersections))
         if not os.path.isdir(parent):
             raise InputError("the output directory does not exist", where=parent)
-    from .memory_budget import default_budget, parse_size
 
     if args.max_memory is not None:
         args.max_memory_bytes = parse_size(args.max_memory, option="--max-memory")
@@ -183,8 +169,6 @@ def _check_mesh_args(args):
 
 def _write_intersections(path, exc):
     """Writes the triangles of the intersecting pairs of ``exc`` to ``path`` for viewing."""
-    from .mesh_types import Surface
-    from .surface_io import write_surface
 
     surface = exc.surface
     pairs = np.asarray(exc.pairs, dtype=np.int64).reshape(-1, 2)
@@ -220,7 +204,6 @@ def _mesh_cad_fem(args, progress):
                          + ", ".join(unsupported) + "; drop them, or add --tessellation to mesh "
                          "OpenCASCADE's display tessellation with the core instead",
                          where=args.input)
-    from .fem.cad_mesh import mesh_cad_file
 
     result = mesh_cad_file(args.input, size=args.size or 0.0, min_size=args.min_size or 0.0,
                            order=args.order, progress=progress)
@@ -233,7 +216,6 @@ def _surface_groups(mesh, surfaces, stats):
     if len(surfaces) != 1 or surfaces[0].face_tags is None or \
             int(stats.get("boundary_steiner_points", 0)) != 0:
         return None
-    from .volume_io import surface_groups
 
     return surface_groups(mesh, surfaces[0])
 
@@ -253,12 +235,11 @@ def _cmd_mesh(args):
         return _finish_mesh(args, progress, t0, mesh, stats, surfaces=None, groups=groups)
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
-    from . import core
 
     if getattr(args, "out_of_core", False):
         progress("tetrahedralizing in pieces")
         try:
-            mesh, stats = core.tetrahedralize_out_of_core(
+            mesh, stats = tetrahedralize_out_of_core(
                 surfaces, args.max_memory_bytes,
                 options={k: v for k, v in (("size", args.size), ("min_size", args.min_size),
                                            ("radius_edge", args.radius_edge),
@@ -314,7 +295,6 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
     for note in stats.get("notes", []):
         print(f"fembsptet: note: {note}", file=sys.stderr)
     if args.stats_json:
-        from .atomic_file import atomic_output
 
         with atomic_output(args.stats_json) as f:
             json.dump(stats, f, indent=1)
@@ -324,7 +304,6 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
         print(mesh_summary(args.input, args.output, mesh, stats, groups))
     if args.compare_tetgen:
         if surfaces is None:
-            from .cad_tessellation import tessellate_file
 
             surfaces = tessellate_file(args.input, size=args.size)
         print(_tetgen_table(surfaces, stats))
@@ -387,7 +366,6 @@ def mesh_summary(source, outputs, mesh, stats, groups):
 
 def _tetgen_table(surfaces, stats):
     """Our counts beside `tetgen -pY` on the same surface(s) (compare/comparison.py)."""
-    from .compare.comparison import format_rows, row_from_stats, tetgen_pY_row
 
     return format_rows([row_from_stats(stats), tetgen_pY_row(surfaces)])
 
@@ -435,8 +413,6 @@ def _summary(report):
 
 
 def _cmd_check(args):
-    from . import core
-    from .surface_io import read_surface
 
     if _ext(args.surface) in CAD_EXTENSIONS:
         return _check_against_cad(args)
@@ -450,7 +426,6 @@ def _cmd_check(args):
     surface = read_surface(args.surface)
     mesh = read_volume(args.tetmesh)
     if _ext(args.tetmesh) in VOLUME_EXTENSIONS:
-        from .volume_io import stored_points
 
         # the reference as the mesh's format stores coordinates (.inp rounds some)
         surface.points = stored_points(args.tetmesh, surface.points)
@@ -470,7 +445,6 @@ def _cmd_check(args):
 def _check_against_cad(args):
     """``check PART.step MESH``: the mesh's own exact validity, tet10 certified, and its boundary
     nodes on the CAD faces (FemBspTet.fem.cad_check)."""
-    from .fem.cad_check import check_against_cad
 
     if not os.path.isfile(args.surface):
         raise InputError("file not found", where=args.surface)
@@ -497,7 +471,6 @@ def _check_against_cad(args):
 
 
 def _cmd_render(args):
-    from .render import render_mesh
 
     if _ext(args.output) != ".png":
         raise InputError("the picture is written as PNG: name it FILE.png", where=args.output)
@@ -512,7 +485,6 @@ def _cmd_render(args):
 
 
 def _cmd_freecad_install(args):
-    from .addon_install import install
 
     for line in install(args.mod_dir, uninstall=args.uninstall):
         print(f"fembsptet: {line}")
@@ -529,7 +501,6 @@ def _positive_option(value, option):
 
 def _cmd_compare(args):
     """Our mesher, TetGen and Gmsh on the same surface: one table (compare/comparison.py)."""
-    from .compare.comparison import MESHERS, compare, format_table, plot_histograms, write_json
 
     _positive_option(args.size, "--size")
     _positive_option(args.timeout, "--timeout")
@@ -554,8 +525,6 @@ def _cmd_compare(args):
 
 def _cmd_benchmark(args):
     """``compare`` over folders of models, as a markdown report (compare/benchmark.py)."""
-    from .compare.benchmark import model_paths, run_benchmark, write_report
-    from .compare.comparison import MESHERS
 
     _positive_option(args.divisions, "--divisions")
     _positive_option(args.timeout, "--timeout")
@@ -684,7 +653,6 @@ def build_parser():
     f.add_argument("--uninstall", action="store_true", help="remove the links instead")
     f.set_defaults(func=_cmd_freecad_install)
 
-    from .compare.process import DEFAULT_TIMEOUT
 
     k = sub.add_parser("compare", help="our mesher, tetgen and gmsh on the same surface: a table")
     k.add_argument("input", help="surface (.off .stl .obj .ply) or CAD (.step .stp .brep .iges); "
@@ -721,29 +689,6 @@ def build_parser():
     return p
 
 
-def _run_reporting(func, args):
-    """Runs ``func(args)``; every error becomes one message on stderr and an exit code."""
-    try:
-        return func(args)
-    except InputError as exc:
-        print(f"fembsptet: error: {exc}", file=sys.stderr)
-        return 2
-    except BspTetError as exc:
-        print(f"fembsptet: {exc}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt:
-        print("fembsptet: interrupted; no output was written", file=sys.stderr)
-        return 130
-    except MemoryError:
-        print("fembsptet: error: out of memory; no output was written (set a --max-memory budget "
-              "or mesh a coarser tessellation)", file=sys.stderr)
-        return 2
-    except Exception:  # noqa: BLE001 - last resort: report and exit 1, never a bare traceback
-        print("fembsptet: internal error (please report it with the input):", file=sys.stderr)
-        traceback.print_exc()
-        return 1
-
-
 def _mesh_outputs(args):
     """Every file a mesh run may write (the supervisor removes their temporaries)."""
     outputs = list(args.output)
@@ -758,19 +703,17 @@ def _mesh_outputs(args):
 
 def _supervised_mesh(args):
     """``mesh`` in a supervised child process (--timeout, --max-memory: supervisor.py)."""
-    from .supervisor import Limits, run_supervised
 
     _check_mesh_args(args)
     limits = Limits(timeout=args.timeout, max_memory=args.max_memory_bytes)
-    return run_supervised(lambda: _run_reporting(_cmd_mesh, args), limits, _mesh_outputs(args))
+    return run_supervised(lambda: report_errors(_cmd_mesh, args), limits, _mesh_outputs(args))
 
 
 def _interruptible_mesh(args):
     """``mesh`` in this process; Ctrl-C stops it at once and leaves no partial file."""
-    from .supervisor import run_interruptible
 
     _check_mesh_args(args)
-    return run_interruptible(lambda: _run_reporting(_cmd_mesh, args), _mesh_outputs(args))
+    return run_interruptible(lambda: report_errors(_cmd_mesh, args), _mesh_outputs(args))
 
 
 def main(argv=None, supervise=True):
@@ -782,11 +725,11 @@ def main(argv=None, supervise=True):
     args.raw_argv = list(sys.argv[1:] if argv is None else argv)
     if args.command == "mesh" and supervise:
         limited = args.timeout is not None or args.max_memory is not None
-        return _run_reporting(_supervised_mesh if limited else _interruptible_mesh, args)
+        return report_errors(_supervised_mesh if limited else _interruptible_mesh, args)
     if args.command == "mesh" and args.timeout is not None:
         print("fembsptet: error: --timeout needs the supervised run", file=sys.stderr)
         return 2
-    return _run_reporting(args.func, args)
+    return report_errors(args.func, args)
 
 
 if __name__ == "__main__":

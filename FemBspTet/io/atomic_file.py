@@ -5,7 +5,7 @@ A writer opens :func:`atomic_output` (or :func:`atomic_outputs` for formats made
 files, such as TetGen's ``.node`` + ``.ele``) and writes into the object it yields. The data
 go to a temporary file in the *same directory* as the target, named
 ``.<target name>.<pid>.<random>.tmp`` (the process id lets a supervising process find and remove
-the temporary files of a worker it had to stop: :mod:`FemBspTet.supervisor`). On a normal exit the temporary file is flushed, ``fsync``-ed
+the temporary files of a worker it had to stop: :mod:`FemBspTet.cli.supervisor`). On a normal exit the temporary file is flushed, ``fsync``-ed
 and renamed onto the target with :func:`os.replace`, which is atomic on POSIX file systems.
 On any exception inside the ``with`` block the temporary file is deleted, the exception
 propagates unchanged and the target is untouched: a previous file of that name survives.
@@ -14,7 +14,7 @@ The new file gets the permissions an ordinary ``open(path, "w")`` would give it 
 less the umask), or keeps the mode of the file it replaces.
 
 Errors of the file system itself (missing directory, no permission, disk full) are raised as
-:class:`~FemBspTet.errors.InputError` naming the target path, since the user can fix them.
+:class:`~FemBspTet.kernel.errors.InputError` naming the target path, since the user can fix them.
 """
 
 import contextlib
@@ -22,7 +22,7 @@ import os
 import stat
 import tempfile
 
-from .errors import InputError
+from ..kernel.errors import InputError
 
 __all__ = ["atomic_output", "atomic_outputs"]
 

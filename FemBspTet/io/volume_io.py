@@ -3,7 +3,7 @@
 
 Pure Python + numpy (+ the standard library's XML, base64, zlib, lzma); no FreeCAD, no meshio.
 
-In memory (see :mod:`FemBspTet.mesh_types`) a :class:`~FemBspTet.mesh_types.TetMesh` has
+In memory (see :mod:`FemBspTet.kernel.mesh_types`) a :class:`~FemBspTet.kernel.mesh_types.TetMesh` has
 0-based indices, positively oriented tets (``det[b-a, c-a, d-a] > 0``) and, for second order,
 the node order ``[n1, n2, n3, n4, m12, m23, m31, m14, m24, m34]``. Readers and writers convert
 index base and node order; they never reorient (a reader reports what the file holds).
@@ -62,7 +62,7 @@ face triangles found in MSH / Medit / VTU files (0-based, corners first, then mi
 ``m_ab, m_bc, m_ca``) and ``"triangle_tags"`` (k,): their face tag, i.e. the file's tag - 1
 (the inverse of what the writers do).
 
-Errors are :class:`~FemBspTet.errors.InputError` with ``where`` naming the file and the line
+Errors are :class:`~FemBspTet.kernel.errors.InputError` with ``where`` naming the file and the line
 (or the XML element / byte offset for binary VTU data).
 """
 
@@ -76,8 +76,9 @@ import zlib
 import numpy as np
 
 from .atomic_file import atomic_output, atomic_outputs
-from .errors import InputError, InternalError
-from .mesh_types import MeshGroups, TetMesh
+from .formats import VOLUME_EXTENSIONS
+from ..kernel.errors import InputError, InternalError
+from ..kernel.mesh_types import MeshGroups, TetMesh
 from .surface_io import (
     _GENERATOR,
     _Text,
@@ -94,9 +95,6 @@ from .surface_io import (
 
 __all__ = ["read_tet_mesh", "write_tet_mesh", "surface_groups", "stored_points", "read_tetgen", "tetgen_paths",
            "VOLUME_EXTENSIONS", "GMSH_TET10_ORDER", "TETGEN_TET10_ORDER"]
-
-#: Extensions :func:`read_tet_mesh` and :func:`write_tet_mesh` understand (case-insensitive).
-VOLUME_EXTENSIONS = (".vtu", ".msh", ".inp", ".node", ".ele", ".mesh")
 
 #: ``gmsh_tet10 = ours[GMSH_TET10_ORDER]`` (the permutation is its own inverse).
 GMSH_TET10_ORDER = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 8])
@@ -125,7 +123,7 @@ def tetgen_paths(path):
 def write_tet_mesh(path, mesh, groups=None):
     """Write ``mesh`` to ``path`` (atomically); the format follows the extension.
 
-    ``groups`` (optional, a :class:`~FemBspTet.mesh_types.MeshGroups`: the CAD faces' triangles
+    ``groups`` (optional, a :class:`~FemBspTet.kernel.mesh_types.MeshGroups`: the CAD faces' triangles
     and each tet's solid, with their names) become the format's named sets (see the module
     doc); :func:`surface_groups` makes them from a tagged surface. ``.node`` / ``.ele`` write
     both TetGen files.
@@ -142,7 +140,7 @@ def write_tet_mesh(path, mesh, groups=None):
 
 
 def surface_groups(mesh, surface, where=""):
-    """:class:`~FemBspTet.mesh_types.MeshGroups` of ``surface``'s triangles (its vertices
+    """:class:`~FemBspTet.kernel.mesh_types.MeshGroups` of ``surface``'s triangles (its vertices
     matched to mesh nodes by exact coordinates; its ``face_tags`` and ``face_names``, or one
     face "Face1" without tags) and one solid "Solid1". InputError if a surface vertex or edge
     is not one of the mesh's."""
@@ -162,7 +160,7 @@ def surface_groups(mesh, surface, where=""):
 def read_tet_mesh(path):
     """Read a tetrahedral mesh from ``path``; the format follows the extension.
 
-    Returns a :class:`~FemBspTet.mesh_types.TetMesh` in our conventions (0-based, our tet10
+    Returns a :class:`~FemBspTet.kernel.mesh_types.TetMesh` in our conventions (0-based, our tet10
     order). Raises :class:`InputError` naming file and place for anything it cannot read.
     """
     path = os.fspath(path)

@@ -27,9 +27,9 @@ tagged faces (measured: below 1e-13). For imported files whose edges carry large
 vertex near such an edge can lie on the underlying surface but outside the trimmed face, up to
 about that edge tolerance (``bottle.brep``: up to 0.02 mm, edge tolerance 0.0155 mm).
 
-Conventions (see :mod:`FemBspTet.mesh_types`):
+Conventions (see :mod:`FemBspTet.kernel.mesh_types`):
 
-* One :class:`~FemBspTet.mesh_types.Surface` per solid, in ``shape.Solids`` order.
+* One :class:`~FemBspTet.kernel.mesh_types.Surface` per solid, in ``shape.Solids`` order.
 * ``face_tags[t]`` is the 0-based index of the triangle's face in the ORIGINAL shape's
   ``shape.Faces`` list, for every solid (also inside a compound); ``face_names[k]`` is
   ``"Face<k+1>"``, the sub-element name FreeCAD uses for ``shape.Faces[k]``. ``face_names`` has
@@ -49,8 +49,10 @@ import os
 
 import numpy as np
 
-from .errors import InputError, InternalError
-from .mesh_types import Surface
+from ..kernel import core
+from ..kernel.errors import InputError, InternalError
+from ..kernel.freecad_env import import_freecad
+from ..kernel.mesh_types import Surface
 
 #: File extensions :func:`tessellate_file` reads, with the format names used in messages.
 CAD_FORMATS = {
@@ -103,7 +105,6 @@ def tessellate_shape(shape, linear_deflection, angular_deflection=0.5, relative=
     message names the CAD faces at the open edges), not consistently oriented, or encloses a
     volume far from ``solid.Volume``.
     """
-    from .freecad_env import import_freecad
 
     import_freecad()
     import Part
@@ -177,7 +178,6 @@ def read_cad_shape(path):
 
     Raises InputError (``where`` = the path) for a missing file, an unsupported extension, a
     file FreeCAD cannot read and a file without shapes."""
-    from .freecad_env import import_freecad
 
     path = os.fspath(path)
     where = path
@@ -743,7 +743,6 @@ def flip_out_fins_of(surfaces):
     alone). A changed surface is used only if it passes the core's exact input check; else the
     solid keeps its tessellation. Returns ``(surfaces, stats)``: ``fins_before``, ``fins_after``
     and ``flips`` summed over the solids whose surface is used, and ``not_used``."""
-    from . import core
 
     frozen = shared_face_tags(surfaces)
     out, total = [], {"fins_before": 0, "fins_after": 0, "flips": 0, "not_used": 0}

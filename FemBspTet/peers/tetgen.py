@@ -11,8 +11,9 @@ import os
 import shutil
 import tempfile
 
-from ..errors import InternalError
-from ..mesh_types import Surface, TetMesh
+from ..io.volume_io import read_tetgen
+from ..kernel.errors import InternalError
+from ..kernel.mesh_types import Surface, TetMesh
 from .process import run_measured
 
 
@@ -67,7 +68,6 @@ def run_tetgen(surface: Surface, switches="pY", timeout=None, keep_dir=None,
     exe = tetgen_path()
     if exe is None:
         raise InternalError("tetgen is not installed (Debian package tetgen); run scripts/setup.sh")
-    from ..volume_io import read_tetgen
 
     workdir = keep_dir or tempfile.mkdtemp(prefix="fembsptet_tetgen_")
     try:

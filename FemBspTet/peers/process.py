@@ -26,6 +26,10 @@ import shutil
 import signal
 import subprocess
 import time
+import tempfile
+import threading
+
+from ..kernel.paths import ADDON_DIR
 
 #: Seconds a comparison run may take by default (``--timeout`` changes it).
 DEFAULT_TIMEOUT = 600.0
@@ -55,8 +59,6 @@ def run_measured(command, timeout=DEFAULT_TIMEOUT, cwd=None, env=None):
     is taken the moment the process exits (no polling step: a run of 10 ms and one of 40 ms are
     told apart, which matters for the time ratios of small models).
     """
-    import tempfile
-    import threading
 
     command = [str(c) for c in command]
     gnu_time = shutil.which("time", path="/usr/bin:/bin")
@@ -98,3 +100,13 @@ def run_measured(command, timeout=DEFAULT_TIMEOUT, cwd=None, env=None):
     return ProcessRun(command=command, seconds=seconds, peak_rss_mb=peak_kib / 1024.0,
                       returncode=None if timed_out else proc.returncode, output=text,
                       timed_out=timed_out, rss_floor=gnu_time is None)
+
+
+def worker_env():
+    """Environment of a worker interpreter of ours: the addon folder first on its PYTHONPATH,
+    and no PYTHONHOME (FreeCAD's own, if any, is not the worker's)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = ADDON_DIR + (os.pathsep + env["PYTHONPATH"]
+                                     if env.get("PYTHONPATH") else "")
+    env.pop("PYTHONHOME", None)
+    return env

@@ -1,0 +1,215 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The BspTet mesher document object: ``Fem::FemMeshObjectPython`` with proxy type
+``Fem::FemMeshBspTet``, made the way FreeCAD 0.20.2 makes its Gmsh and Netgen mesh objects.
+
+    obj = make_mesher(doc, part, CharacteristicLengthMax=500, ElementOrder="2nd")
+    FemBspTet.run_mesher(obj)            # meshes it (mesher_tools); recompute never meshes
+
+* C++ type ``Fem::FemMeshObjectPython`` (the type FEM's Gmsh object has in 0.20/0.21; 1.x still
+  has it), so CalculiX, Z88 and Mystran take the object as the analysis mesh. The proxy's
+  ``Type`` is ``Fem::FemMeshBspTet``: FEM never mistakes it for Gmsh.
+* ``Part`` (App::PropertyLink): the solid the mesh is made from. FEM's writers read
+  ``mesh_obj.Part`` when there is no ``Shape``.
+* Parameters mean what FemMeshGmsh's mean where the names are the same
+  (``CharacteristicLengthMax``/``Min``: 0 = automatic; ``ElementOrder`` "1st"/"2nd").
+* Results (read-only in the property editor) are set by ``mesher_tools.apply_result``.
+* Saved files store ``module="FemBspTet.freecad.mesher_object" class="MeshBspTet"``: never rename
+  them (files of earlier versions store ``FemBspTet.mesher_object``, kept as a thin module).
+  Properties are added only if missing, from ``__init__`` and from ``onDocumentRestored`` (files
+  of older versions gain new properties with their defaults). The parameters of the former
+  tessellation pipeline (``LinearDeflection``, ``AngularDeflection``, ``QualityBound``,
+  ``ThicknessRatio``, ``AllowBoundarySteiner``, ``RemeshSurface``, ``StraightenMidNodes``) are
+  removed from restored objects: FreeCAD restores dynamic properties from the file whether or
+  not the proxy knows them, so the files open as before, and nothing reads those values.
+"""
+
+from ..fem.mesh_pipeline import REMOVED_BECAUSE, removed_parameter_message, REMOVED_PARAMETERS
+from ..kernel.errors import InputError
+from ..kernel.freecad_env import import_freecad
+from .preferences import object_defaults
+
+#: Proxy type (``femutils.type_of_obj``).
+PROXY_TYPE = "Fem::FemMeshBspTet"
+#: C++ type of the document object.
+OBJECT_TYPE = "Fem::FemMeshObjectPython"
+
+PARAMS_GROUP = "BspTet Mesh Params"
+RESULTS_GROUP = "BspTet Mesh Results"
+
+#: (type, name, group, tooltip, default) of every parameter property.
+PARAMETER_PROPERTIES = (
+    ("App::PropertyLink", "Part", "FEM Mesh", "The solid (Part) the mesh is made from", None),
+    ("App::PropertyLength", "CharacteristicLengthMax", PARAMS_GROUP,
+     "Largest element size (0 = automatic: the bounding-box diagonal / 20). Curved faces and "
+     "edges get smaller elements (12 per full circle)", 0.0),
+    ("App::PropertyLength", "CharacteristicLengthMin", PARAMS_GROUP,
+     "Smallest element size (0 = automatic: CharacteristicLengthMax / 50)", 0.0),
+    ("App::PropertyEnumeration", "ElementOrder", PARAMS_GROUP,
+     "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
+     ("1st", "2nd")),
+    ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
+     "Add the boundary triangles as faces, and a face group and a node group per CAD face "
+     "(BspTet_Face1, ...)", False),
+    ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
+     "Also run tetgen -pY on OpenCASCADE's display tessellation of the part and show its "
+     "counts", True),
+)
+
+#: (type, name, tooltip) of every read-only result property.
+RESULT_PROPERTIES = (
+    ("App::PropertyString", "MeshStatus", "Outcome of the last meshing run"),
+    ("App::PropertyInteger", "Nodes", "Nodes of the mesh"),
+    ("App::PropertyInteger", "Tetrahedra", "Tetrahedra of the mesh"),
+    ("App::PropertyInteger", "SteinerPoints",
+     "Corner nodes the volume mesher added to the CAD surface mesh's nodes"),
+    ("App::PropertyInteger", "BoundarySteinerPoints",
+     "Of those, the ones on the CAD faces (refinement of the surface)"),
+    ("App::PropertyFloat", "MinDihedralAngle", "Smallest dihedral angle (degrees)"),
+    ("App::PropertyFloat", "MaxRadiusEdgeRatio", "Largest radius-edge ratio"),
+    ("App::PropertyFloat", "MeshingTime", "Seconds of the last run (CAD to mesh)"),
+    ("App::PropertyStringList", "MeshNotes", "What the mesher could not do as asked, warnings"),
+    ("App::PropertyString", "TetGenCommand",
+     "The TetGen run of the comparison (on OpenCASCADE's display tessellation)"),
+    ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the display tessellation"),
+    ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the display "
+     "tessellation"),
+    ("App::PropertyInteger", "TetGenSteinerPoints", "TetGen's Steiner points"),
+    ("App::PropertyInteger", "TetGenBoundarySteinerPoints", "TetGen's Steiner points on the "
+     "surface"),
+    ("App::PropertyFloat", "TetGenMinDihedralAngle", "Smallest dihedral angle of TetGen's mesh"),
+    ("App::PropertyFloat", "TetGenMaxRadiusEdgeRatio", "Largest radius-edge ratio of TetGen's "
+     "mesh"),
+    ("App::PropertyFloat", "TetGenTime", "TetGen's seconds"),
+    ("App::PropertyFloat", "TetGenPeakMemory", "Peak memory of the TetGen process (MB)"),
+    ("App::PropertyBool", "TetGenValid", "Our exact checker accepts TetGen's mesh"),
+)
+
+#: Result property of each field of a comparison row (``compare.comparison.Row``), for our mesh
+#: and for TetGen's: ``mesher_tools.apply_result`` fills them, the task panel's table reads them.
+ROW_PROPERTIES = {
+    "ours": {"nodes": "Nodes", "tets": "Tetrahedra", "steiner_points": "SteinerPoints",
+             "steiner_boundary": "BoundarySteinerPoints", "min_dihedral_deg": "MinDihedralAngle",
+             "max_radius_edge_ratio": "MaxRadiusEdgeRatio", "seconds": "MeshingTime"},
+    "tetgen-pY": {"command": "TetGenCommand", "nodes": "TetGenNodes", "tets": "TetGenTetrahedra",
+                  "steiner_points": "TetGenSteinerPoints",
+                  "steiner_boundary": "TetGenBoundarySteinerPoints",
+                  "min_dihedral_deg": "TetGenMinDihedralAngle",
+                  "max_radius_edge_ratio": "TetGenMaxRadiusEdgeRatio", "seconds": "TetGenTime",
+                  "peak_rss_mb": "TetGenPeakMemory", "valid": "TetGenValid"},
+}
+
+
+def add_properties(obj):
+    """Add every missing property of the mesher object, and remove the parameters of the
+    former tessellation pipeline (``mesh_pipeline.REMOVED_PARAMETERS``) from objects of older
+    files, saying so on the console. Used on creation and to upgrade restored objects. Returns
+    the names removed."""
+
+    removed = [name for name in REMOVED_PARAMETERS.values() if name in obj.PropertiesList]
+    for name in removed:
+        obj.removeProperty(name)
+    existing = set(obj.PropertiesList)
+    for kind, name, group, tip, default in PARAMETER_PROPERTIES:
+        if name in existing:
+            continue
+        obj.addProperty(kind, name, group, tip)
+        if kind == "App::PropertyEnumeration":
+            setattr(obj, name, list(default))
+            setattr(obj, name, default[-1])
+        elif default is not None:
+            setattr(obj, name, default)
+    for kind, name, tip in RESULT_PROPERTIES:
+        if name not in existing:
+            obj.addProperty(kind, name, RESULTS_GROUP, tip)
+        obj.setEditorMode(name, 1)  # read-only in the property editor
+    return removed
+
+
+class StatelessProxy:
+    """Proxy serialisation with no state, for both pairs FreeCAD calls: __getstate__/__setstate__
+    (0.20) and dumps/loads (newer versions). Everything lives in the object's properties."""
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+
+class MeshBspTet(StatelessProxy):
+    """Proxy of the mesher object. Holds no state of its own (everything is in properties)."""
+
+    Type = PROXY_TYPE
+
+    def __init__(self, obj):
+        obj.Proxy = self
+        add_properties(obj)
+
+    def onDocumentRestored(self, obj):
+        removed = add_properties(obj)
+        if removed:
+            import FreeCAD
+
+
+            FreeCAD.Console.PrintMessage(
+                "FemBspTet: %s: removed the former mesher properties %s (%s)\n"
+                % (obj.Label, ", ".join(removed), REMOVED_BECAUSE.split(";")[0]))
+
+    def execute(self, obj):
+        """Recompute never meshes (as FEM's Gmsh object): meshing is an explicit action."""
+        return None
+
+
+def is_mesher(obj):
+    """True if ``obj`` is a BspTet mesher object."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == PROXY_TYPE
+
+
+def make_mesher(doc, part=None, name="MeshBspTet", **properties):
+    """Create a BspTet mesher object in ``doc`` for ``part`` (not meshed yet).
+
+    doc:        a FreeCAD document.
+    part:       the document object with the solid (``Part::Feature`` and the like), or None.
+    name:       the object's name (FreeCAD makes it unique).
+    properties: property values, e.g. ``CharacteristicLengthMax=500, ElementOrder="1st"``; the
+                preferences (Edit > Preferences > FEM > BspTet) give the others.
+
+    Returns the object. Raises InputError for an unknown property name or a bad value.
+    """
+
+    freecad = import_freecad()
+    import Fem  # noqa: F401  (registers the Fem:: document object types)
+
+
+    known = {p[1] for p in PARAMETER_PROPERTIES}
+    removed = set(properties) & set(REMOVED_PARAMETERS.values())
+    if removed:
+        raise InputError("mesher property: " + removed_parameter_message(removed))
+    unknown = set(properties) - known
+    if unknown:
+        raise InputError("unknown mesher propert%s %s; the parameters are %s"
+                         % ("y" if len(unknown) == 1 else "ies", ", ".join(sorted(unknown)),
+                            ", ".join(sorted(known - {"Part"}))))
+    obj = doc.addObject(OBJECT_TYPE, name)
+    MeshBspTet(obj)
+    values = dict(object_defaults())
+    values.update(properties)
+    if part is not None:
+        values["Part"] = part
+    try:
+        for key, value in values.items():
+            setattr(obj, key, value)
+    except Exception as e:
+        doc.removeObject(obj.Name)
+        raise InputError("mesher property %s: %s" % (key, e)) from None
+    if freecad.GuiUp:
+        from ..gui.view_provider import VPMeshBspTet
+
+        VPMeshBspTet(obj.ViewObject)
+    return obj
