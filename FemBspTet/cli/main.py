@@ -39,7 +39,7 @@ from ..io.cad_tessellation import tessellate_file
 from ..io.formats import (CAD_EXTENSIONS, extension, FREECAD_VOLUME_EXTENSIONS,
                           SURFACE_EXTENSIONS, VOLUME_EXTENSIONS)
 from ..io.inputs import load_input
-from ..io.render import render_mesh
+from ..io.render import render_bsp_cells, render_mesh
 from ..io.surface_io import read_surface, write_surface
 from ..io.volume_io import read_tet_mesh, stored_points, surface_groups, write_tet_mesh
 from ..kernel import core
@@ -484,6 +484,18 @@ def _cmd_render(args):
     return 0
 
 
+def _cmd_cells(args):
+    if _ext(args.output) != ".png":
+        raise InputError("the picture is written as PNG: name it FILE.png", where=args.output)
+    surfaces = load_input(args.input)
+    if len(surfaces) != 1:
+        raise InputError(f"{len(surfaces)} solids: the cell picture takes one", where=args.input)
+    drawn = render_bsp_cells(surfaces[0], args.output, explode=args.explode,
+                             outside=args.outside, size_px=args.size)
+    print(f"fembsptet: wrote {args.output} ({drawn['cells']:,} cells, {drawn['inside']:,} inside)")
+    return 0
+
+
 def _cmd_freecad_install(args):
 
     for line in install(args.mod_dir, uninstall=args.uninstall):
@@ -644,6 +656,18 @@ def build_parser():
                    help="remove the near half and colour the tets by their smallest dihedral angle")
     r.add_argument("--size", type=int, default=900, metavar="PIXELS", help="width and height")
     r.set_defaults(func=_cmd_render)
+
+    b = sub.add_parser("cells", help="the paper's picture of a surface's BSP (PNG): the convex "
+                                     "cells of the box split by the triangles' planes, exploded")
+    b.add_argument("input", help="surface (.off .stl .obj .ply) or CAD file (tessellated through "
+                                 "FreeCAD), at most 5000 triangles")
+    b.add_argument("-o", "--output", required=True, metavar="FILE.png")
+    b.add_argument("--explode", type=float, default=0.4,
+                   help="how far the cells move apart (fraction of their distance to the centre)")
+    b.add_argument("--outside", action="store_true",
+                   help="draw the cells outside the solid too (faint, out to the box)")
+    b.add_argument("--size", type=int, default=900, metavar="PIXELS", help="width and height")
+    b.set_defaults(func=_cmd_cells)
 
     f = sub.add_parser("freecad-install",
                        help="link this FemBspTet into FreeCAD's user Mod folders (FreeCAD 0.20 "

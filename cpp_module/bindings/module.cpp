@@ -617,6 +617,29 @@ PYBIND11_MODULE(_bsptet, m) {
       "face_tolerance (faces of the model,)).");
 
   m.def(
+      "bsp_cells_view",
+      [](const DoubleArray& points, const IndexArray& triangles) {
+        const SurfaceMesh s = surface_from(points, triangles);
+        BspCellsView v;
+        {
+          py::gil_scoped_release release;
+          v = bsp_cells_view(s);
+        }
+        py::array_t<double> pts({static_cast<py::ssize_t>(v.points.size()), static_cast<py::ssize_t>(3)});
+        auto out = pts.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < v.points.size(); ++i) {
+          out(static_cast<py::ssize_t>(i), 0) = v.points[i].x;
+          out(static_cast<py::ssize_t>(i), 1) = v.points[i].y;
+          out(static_cast<py::ssize_t>(i), 2) = v.points[i].z;
+        }
+        return py::make_tuple(pts, v.cells, v.inside);
+      },
+      py::arg("points"), py::arg("triangles"),
+      "The BSP's leaf cells of the box partition by the input planes (mesher.h bsp_cells_view): "
+      "(points (n, 3) rounded, cells: per cell a list of faces, each a list of vertex indices "
+      "counter-clockwise seen from outside the cell, inside: per cell 1 or 0).");
+
+  m.def(
       "orient3d",
       [](std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> c, std::array<double, 3> d) {
         auto v = [](const std::array<double, 3>& p) { return Vec3{p[0], p[1], p[2]}; };

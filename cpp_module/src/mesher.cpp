@@ -547,4 +547,42 @@ TetMesh check_and_tetrahedralize(const SurfaceMesh& input, const SurfaceCheckOpt
   return mesh;
 }
 
+BspCellsView bsp_cells_view(const SurfaceMesh& input) {
+  const SurfaceMesh surface = validated_surface(input);
+  std::vector<Vec3> pts;
+  pts.reserve(surface.num_points() + 8);
+  for (Index i = 0; i < surface.num_points(); ++i) pts.push_back(surface.point(i));
+  for (const Vec3& c : BspComplex::box_corners(surface)) pts.push_back(c);
+  ImplicitGeometry geo(std::move(pts));
+  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
+  const std::vector<Index> tri_plane = group_planes(geo, surface);
+  for (Index t = 0; t < surface.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) geo.note_on_plane(surface.tri[3 * t + k], tri_plane[t]);
+  BspComplex bsp(geo, surface, tri_plane, BspSeed::kBox);
+  bsp.build(nullptr, nullptr);
+  bsp.identify_input_vertices();
+  const CellLabels labels = classify_cells(bsp);
+
+  BspCellsView view;
+  view.points.reserve(static_cast<std::size_t>(geo.num_vertices()));
+  for (Index v = 0; v < geo.num_vertices(); ++v) view.points.push_back(geo.rounded(v));
+  const auto& faces = bsp.faces();
+  for (Index c = 0; c < static_cast<Index>(bsp.cells().size()); ++c) {
+    const BspCell& cell = bsp.cells()[c];
+    if (!cell.alive) continue;
+    std::vector<std::vector<Index>> cycles;
+    for (const Index f : cell.faces) {
+      const BspFace& face = faces[f];
+      std::vector<Index> cycle = face.verts;
+      // CCW around the plane normal, which points into cell[0]: seen from outside cell[0] the
+      // cycle is clockwise, so reverse it there
+      if (face.cell[0] == c) std::reverse(cycle.begin(), cycle.end());
+      cycles.push_back(std::move(cycle));
+    }
+    view.cells.push_back(std::move(cycles));
+    view.inside.push_back(labels.winding[static_cast<std::size_t>(c)] != 0 ? 1 : 0);
+  }
+  return view;
+}
+
 }  // namespace bsptet

@@ -115,4 +115,18 @@ TetMesh check_and_tetrahedralize(const SurfaceMesh& surface, const SurfaceCheckO
                                  const MeshOptions& options = {}, MeshStats* stats = nullptr,
                                  SurfaceCheckResult* checked = nullptr);
 
+/// The paper's picture of the BSP (its Figs. 2-6): the leaf cells of the auto-partition of a box
+/// around `surface` by the planes of its triangles, each a convex polyhedron, inside the solid
+/// (winding 1) or outside (0). For display only: the vertices are rounded to doubles.
+struct BspCellsView {
+  std::vector<Vec3> points;  ///< every vertex of the complex, rounded
+  /// Per leaf cell, its faces, each a vertex cycle (counter-clockwise seen from outside the cell).
+  std::vector<std::vector<std::vector<Index>>> cells;
+  std::vector<int> inside;  ///< per cell: 1 inside the solid, 0 outside
+};
+
+/// Builds the view (validate_surface's errors for a bad surface). The box partition is the
+/// paper's; the mesher itself usually starts from a Delaunay seed instead (bsp_seed.h).
+BspCellsView bsp_cells_view(const SurfaceMesh& surface);
+
 }  // namespace bsptet
