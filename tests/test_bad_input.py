@@ -505,3 +505,22 @@ def test_meshing_error_of_the_core_becomes_exit_1_and_no_file(tmp_path, monkeypa
     assert code == 1, err
     assert "the mesher failed" in err and "please report it" in err and "schoenhardt.off" in err
     assert os.listdir(tmp_path) == []
+
+
+def test_error_codes_are_the_cores():
+    """The Python ErrorCode enum and the core's (errors.h, bound as _bsptet.ErrorCode) are one
+    table; every input error the core raises carries a member."""
+    from FemBspTet import _bsptet
+    from FemBspTet.kernel.errors import ErrorCode
+
+    native = set(_bsptet.ErrorCode.__members__)
+    ours = {c.value for c in ErrorCode}
+    assert native <= ours and ours - native == {"memory_budget"}
+    from FemBspTet.kernel import core
+    from FemBspTet.kernel.errors import InputError
+    from FemBspTet.kernel.mesh_types import Surface
+
+    pts, tris = box()
+    with pytest.raises(InputError) as info:
+        core.tetrahedralize(Surface(pts, tris[:-1]))
+    assert info.value.code is ErrorCode.OPEN_BOUNDARY and info.value.code == "open_boundary"

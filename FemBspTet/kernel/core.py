@@ -19,7 +19,7 @@ import contextlib
 import numpy as np
 
 from .. import __version__
-from .errors import Cancelled, InputError, InternalError, SelfIntersectionError
+from .errors import Cancelled, ErrorCode, InputError, InternalError, SelfIntersectionError
 from .memory_budget import require_within_budget
 from .mesh_types import Surface, TetMesh
 
@@ -106,7 +106,7 @@ def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000, sel
     except lib.InputError as exc:
         raise InputError(str(exc), where=where, code=getattr(exc, "code", None)) from None
     except ValueError as exc:  # array shapes or indices beyond 32 bits (the binding's checks)
-        raise InputError(str(exc), where=where, code="bad_argument") from None
+        raise InputError(str(exc), where=where, code=ErrorCode.BAD_ARGUMENT) from None
     info = dict(info)
     if info["flipped_triangles"]:
         surface = Surface(surface.points, tri, surface.face_tags, surface.source)

@@ -13,8 +13,42 @@ where it can, what to do about it. The CLI maps them to exit codes:
 :func:`report_errors` turns them into one message and that exit code.
 """
 
+import enum
 import sys
 import traceback
+
+
+class ErrorCode(str, enum.Enum):
+    """What an :class:`InputError` is about (``error.code``), as the core names it
+    (``cpp_module/include/bsptet/errors.h``, bound as ``_bsptet.ErrorCode``; a test keeps the two
+    equal), and the codes of this package's own input errors. A member equals its string."""
+
+    BAD_ARGUMENT = "bad_argument"
+    NON_FINITE_COORDINATE = "non_finite_coordinate"
+    DEGENERATE_TRIANGLE = "degenerate_triangle"
+    DUPLICATE_TRIANGLE = "duplicate_triangle"
+    OPEN_BOUNDARY = "open_boundary"
+    NON_MANIFOLD = "non_manifold"
+    INCONSISTENT_ORIENTATION = "inconsistent_orientation"
+    INWARD_FACING = "inward_facing"
+    SELF_INTERSECTION = "self_intersection"
+    CANCELLED = "cancelled"
+    INTERNAL = "internal"
+    #: raised by this package, not the core: the memory budget is too small
+    MEMORY_BUDGET = "memory_budget"
+
+    def __str__(self):
+        return self.value
+
+    @classmethod
+    def of(cls, code):
+        """The member for ``code`` (a string or member), None for None or an unknown string."""
+        if code is None or isinstance(code, cls):
+            return code
+        try:
+            return cls(str(code))
+        except ValueError:
+            return None
 
 
 class BspTetError(Exception):
@@ -30,8 +64,10 @@ class InputError(BspTetError, ValueError):
 
     def __init__(self, message, where=None, code=None):
         self.where = where
-        #: The core's snake_case error code ("open_boundary", "self_intersection", ...) or None.
-        self.code = code
+        #: An :class:`ErrorCode` (equal to its snake_case string, "open_boundary", ...) or None.
+        self.code = ErrorCode.of(code) if code is not None else None
+        if code is not None and self.code is None:
+            raise ValueError(f"unknown error code {code!r}")
         text = f"{where}: {message}" if where else message
         super().__init__(text)
 
@@ -42,7 +78,7 @@ class SelfIntersectionError(InputError):
     were collected. ``surface`` is the surface they index into."""
 
     def __init__(self, message, where=None, pairs=None, complete=True, surface=None):
-        super().__init__(message, where=where, code="self_intersection")
+        super().__init__(message, where=where, code=ErrorCode.SELF_INTERSECTION)
         self.pairs = pairs
         self.complete = complete
         self.surface = surface
@@ -53,7 +89,7 @@ class MemoryBudgetError(InputError):
     (``--max-memory``). ``estimate`` and ``budget`` are in bytes."""
 
     def __init__(self, message, where=None, estimate=None, budget=None):
-        super().__init__(message, where=where, code="memory_budget")
+        super().__init__(message, where=where, code=ErrorCode.MEMORY_BUDGET)
         self.estimate = estimate
         self.budget = budget
 

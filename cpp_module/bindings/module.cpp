@@ -639,6 +639,16 @@ PYBIND11_MODULE(_bsptet, m) {
       "(points (n, 3) rounded, cells: per cell a list of faces, each a list of vertex indices "
       "counter-clockwise seen from outside the cell, inside: per cell 1 or 0).");
 
+  {
+    // The error codes, as the exceptions' `code` attribute names them (error_code_name).
+    py::enum_<ErrorCode> codes(m, "ErrorCode", "The core's error codes; .name is the snake_case code.");
+    for (const ErrorCode c : {ErrorCode::kBadArgument, ErrorCode::kNonFiniteCoordinate, ErrorCode::kDegenerateTriangle,
+                              ErrorCode::kDuplicateTriangle, ErrorCode::kOpenBoundary, ErrorCode::kNonManifold,
+                              ErrorCode::kInconsistentOrientation, ErrorCode::kInwardFacing,
+                              ErrorCode::kSelfIntersection, ErrorCode::kCancelled, ErrorCode::kInternal})
+      codes.value(error_code_name(c), c);
+  }
+
   m.def(
       "orient3d",
       [](std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> c, std::array<double, 3> d) {
