@@ -121,9 +121,12 @@ class Refiner {
       for (int round = 0; round < 3 && smooth_pass(30.0) > 0; ++round) {
       }
     }
+    st_.worst_deg_optimized = worst_quality();
     timed("curving", [&] { lift_for_curved_elements(); return 0; });
+    st_.worst_deg_curving_room = worst_quality();
     if (o_.projection && o_.order == 2)
       timed("curving", [&] { return polish_curved(kPolishCurvedBelowDeg); });
+    st_.worst_deg = worst_quality();
     // Counted last (the smoothing after separate_face_tags and the lifts move points too) against
     // the asked sizes: the targets raised around edges that could not be split do not count.
     compute_targets(false);
