@@ -342,6 +342,28 @@ TEST_P(CadPipelineOrder, SolidsTouchingAtPoints) {
 INSTANTIATE_TEST_SUITE_P(Orders, CadPipelineOrder, ::testing::Values(1, 2),
                          [](const ::testing::TestParamInfo<int>& info) { return "order" + std::to_string(info.param); });
 
+// The bracket and the red cube with the blue cylinder have no CAD angle under 10 degrees (their
+// faces meet and their face corners turn at right angles): at the default size (diagonal / 20)
+// their tet10 meshes have no tet under 10 degrees. The refinement's stage figures
+// (RefineStats::worst_deg_*) agree with the mesh: its end is the mesh's worst (the merge and the
+// second order keep the refined corners), and the polish after the room made for curved elements
+// only ever raises the worst tet it changes.
+TEST(CadPipeline, NoTetUnderTenDegreesWhereTheCadHasNoSharpAngle) {
+  for (const char* part : {"cad/bracket.step", "cad/red_cube_blue_cylinder.step"}) {
+    const cad::CadModel model = cad::read_cad_file(data(part));
+    fem::FemOptions o;
+    o.order = 2;
+    fem::FemStats st;
+    const fem::FemMesh fm = fem::mesh_cad_model(model, o, &st);
+    ASSERT_GT(fm.mesh.num_tets(), 0) << part;
+    EXPECT_GE(st.min_dihedral_deg, 10.0) << part;
+    EXPECT_EQ(st.tets_below_10_deg, 0.0) << part;
+    EXPECT_EQ(st.refine_worst_deg, st.min_dihedral_deg) << part;
+    EXPECT_GE(st.refine_worst_deg, st.refine_worst_deg_curving_room) << part;
+    EXPECT_LT(st.refine_worst_deg_optimized, 180.0) << part;
+  }
+}
+
 TEST(CadPipeline, CancelledRunThrows) {
   const cad::CadModel model = cad::read_cad_file(data("cad/red_cube_blue_cylinder.step"));
   fem::FemOptions o;

@@ -4,10 +4,11 @@
 //   bsptet_fem PART.step [--size H] [--order 1|2] [--vtu OUT.vtu] [--off OUT.off] [--distance]
 //
 // Prints the sizes, counts, dihedral angles (smallest, median of each tet's smallest, share of
-// tets under 10 degrees) and seconds per stage. --vtu writes the mesh (tets and CAD face
-// triangles, fem_io.h); --off writes the CAD face triangles' corners as one surface; --distance
-// also measures how far the nodes of the face triangles lie from their CAD faces (slow: one
-// OpenCASCADE extrema search per node and face). Exit status: 0, 2 for bad input, 1 otherwise.
+// tets under 10 degrees; the refinement's worst at its stages, RefineStats::worst_deg_*) and
+// seconds per stage. --vtu writes the mesh (tets and CAD face triangles, fem_io.h); --off writes
+// the CAD face triangles' corners as one surface; --distance also measures how far the nodes of
+// the face triangles lie from their CAD faces (slow: one OpenCASCADE extrema search per node and
+// face). Exit status: 0, 2 for bad input, 1 otherwise.
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -68,6 +69,8 @@ int main(int argc, char** argv) {
                 (long long)st.corner_nodes, (long long)st.tets, (long long)st.boundary_triangles);
     std::printf("  dihedral: min %.2f deg, median per-tet worst %.2f deg, tets under 10 deg %.2f%%\n",
                 st.min_dihedral_deg, st.median_tet_min_dihedral_deg, 100.0 * st.tets_below_10_deg);
+    std::printf("  worst dihedral in the refinement: optimized %.2f, room for curved elements %.2f, end %.2f deg\n",
+                st.refine_worst_deg_optimized, st.refine_worst_deg_curving_room, st.refine_worst_deg);
     std::printf("  projection: face %lld (outside trim %lld, fallbacks %lld) edge %lld (no common edge %lld)\n",
                 (long long)st.projection.face_calls, (long long)st.projection.outside_trim,
                 (long long)st.projection.face_fallbacks, (long long)st.projection.edge_calls,

@@ -152,6 +152,12 @@ struct RefineStats {
   std::int64_t curving_lifts = 0;           ///< order 2 with a hook: interior points lifted so that
                                             ///< curved elements stay valid (quality_refine.cpp)
   std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element was still invalid
+  /// Smallest min dihedral angle of the linear tets (degrees) at three points of the stage: when
+  /// the optimization (and separate_face_tags) is done; after the room made for curved elements
+  /// (order 2 with a hook; else the same); and at the end (the output's corner tets). Where the
+  /// worst tet of a mesh comes from: a drop from the first to the second is paid for valid curved
+  /// elements (quality_refine.cpp, lift_for_curved_elements). 180 for a mesh without tets.
+  double worst_deg_optimized = 180, worst_deg_curving_room = 180, worst_deg = 180;
   double seconds = 0;
   /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,
   /// separate_face_tags, curving (the passes that ran).

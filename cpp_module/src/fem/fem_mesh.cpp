@@ -189,6 +189,9 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.midnodes_projected += rst.midnodes_projected;
     st.midnodes_straightened += rst.midnodes_straightened;
     st.curving_conflicts_left += rst.curving_conflicts_left;
+    st.refine_worst_deg_optimized = std::min(st.refine_worst_deg_optimized, rst.worst_deg_optimized);
+    st.refine_worst_deg_curving_room = std::min(st.refine_worst_deg_curving_room, rst.worst_deg_curving_room);
+    st.refine_worst_deg = std::min(st.refine_worst_deg, rst.worst_deg);
     for (const auto& [pass, seconds] : rst.seconds_by_pass) st.refine_seconds_by_pass[pass] += seconds;
 
     // ---- 4. Merge this solid. ----

@@ -92,6 +92,10 @@ struct FemStats {
   std::int64_t projection_refused = 0;    ///< hook answers the quality stage refused (see cad_projection.h)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2, per solid (tet10.h)
   std::int64_t curving_conflicts_left = 0;  ///< order 2: tets the refinement left invalid when curved
+  /// The refinement's worst dihedral angle (degrees, least over the solids) when its optimization
+  /// is done, after it made room for curved elements, and at its end (RefineStats::worst_deg_*);
+  /// the last equals min_dihedral_deg (the merge keeps the refined corners).
+  double refine_worst_deg_optimized = 180, refine_worst_deg_curving_room = 180, refine_worst_deg = 180;
   // Merge (stage 4).
   std::int64_t midnodes_reconciled = 0;  ///< shared mid-nodes two solids placed differently (put on the chord)
   std::int64_t midnodes_straightened_at_merge = 0;  ///< mid-nodes put on their chord after that
