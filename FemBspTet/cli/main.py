@@ -292,6 +292,13 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
     progress.finish()
     stats["seconds_writing"] = time.perf_counter() - t_write
     stats["seconds_total"] = time.perf_counter() - t0
+    unsized = surfaces is not None and all(
+        getattr(args, k, None) is None for k in ("size", "radius_edge", "min_dihedral"))
+    if unsized and args.output:
+        stats.setdefault("notes", []).append(
+            "this is the core's mesh of the surface as given: no element size and no quality "
+            f"bound (worst dihedral angle {stats.get('min_dihedral_deg', float('nan')):.2f} "
+            "degrees); for an FEM mesh give --size H (and --order 2), or mesh the CAD file")
     for note in stats.get("notes", []):
         print(f"fembsptet: note: {note}", file=sys.stderr)
     if args.stats_json:
