@@ -152,3 +152,23 @@ def test_freecad_reads_the_groups(written, name):
     for solid in (0, 1):
         volumes = fem.getGroupElements(found[(f"Solid{solid + 1}", "Volume")])
         assert len(volumes) == int((groups.tet_solid == solid).sum())
+
+
+@pytest.mark.skipif(shutil.which("gmsh") is None, reason="gmsh not installed")
+def test_msh41_groups_through_meshio_and_gmsh(tmp_path):
+    out = tmp_path / "m41.msh"
+    assert main(["mesh", PART, "--order", "2", "--quiet", "--msh-version", "4.1", "-o", str(out)],
+                supervise=False) == 0
+    assert out.read_text().startswith("$MeshFormat\n4.1 0 8\n")
+    result = mesh_cad_file(PART, order=2)
+    groups = result.groups
+    m = meshio.read(out)
+    names = {k: (int(v[0]), int(v[1])) for k, v in m.field_data.items()}
+    assert names["Face9"] == (9, 2) and names["Solid2"] == (2, 3)
+    tets = np.concatenate([c.data for c in m.cells if c.type == "tetra10"])
+    assert len(tets) == len(result.mesh.tets)
+    subprocess.run(["gmsh", str(out), "-0", "-format", "msh22", "-o", "g.msh"], cwd=tmp_path,
+                   check=True, capture_output=True, timeout=300)
+    back = read_tet_mesh(tmp_path / "g.msh")
+    assert np.array_equal(np.bincount(back.extra["region"])[1:], np.bincount(groups.tet_solid))
+    assert np.array_equal(np.bincount(back.extra["triangle_tags"]), np.bincount(groups.face_tags))

@@ -41,7 +41,8 @@ from ..io.formats import (CAD_EXTENSIONS, extension, FREECAD_VOLUME_EXTENSIONS,
 from ..io.inputs import load_input
 from ..io.render import render_bsp_cells, render_mesh
 from ..io.surface_io import read_surface, write_surface
-from ..io.volume_io import read_tet_mesh, stored_points, surface_groups, write_tet_mesh
+from ..io.volume_io import (MSH_VERSIONS, read_tet_mesh, stored_points, surface_groups,
+                            write_tet_mesh)
 from ..kernel import core
 from ..kernel.errors import InputError, report_errors, SelfIntersectionError
 from ..kernel.memory_budget import default_budget, parse_size
@@ -92,7 +93,7 @@ def check_output_path(path):
         raise InputError("the output directory does not exist", where=parent)
 
 
-def write_output(path, mesh, groups=None):
+def write_output(path, mesh, groups=None, msh_version="2.2"):
     """Write ``mesh`` (with its named sets ``groups``, a MeshGroups, when given) to ``path``."""
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
@@ -101,7 +102,7 @@ def write_output(path, mesh, groups=None):
     else:
 
         _check_stored(path, mesh)
-        write_tet_mesh(path, mesh, groups)
+        write_tet_mesh(path, mesh, groups, msh_version=msh_version)
 
 
 def _check_stored(path, mesh):
@@ -288,7 +289,7 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
     if groups is None and surfaces is not None and args.output:
         groups = _surface_groups(mesh, surfaces, stats)
     for out in args.output:
-        write_output(out, mesh, groups)
+        write_output(out, mesh, groups, msh_version=args.msh_version)
     progress.finish()
     stats["seconds_writing"] = time.perf_counter() - t_write
     stats["seconds_total"] = time.perf_counter() - t0
@@ -604,6 +605,9 @@ def build_parser():
                    help="element order (2: 10-node tets)")
     m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
     m.add_argument("--quiet", action="store_true", help="no progress and no summary")
+    m.add_argument("--msh-version", choices=MSH_VERSIONS, default="2.2",
+                   help="the MSH format of .msh outputs (default 2.2, read by every tool that "
+                        "reads MSH; 4.1 is Gmsh 4's own)")
     m.add_argument("--json", action="store_true",
                    help="print the statistics as JSON on stdout instead of the summary")
     m.add_argument("--allow-boundary-steiner", action="store_true",

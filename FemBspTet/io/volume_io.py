@@ -21,7 +21,8 @@ Formats, as written and read here:
            (raw or base64) data, uncompressed or with ``vtkZLibDataCompressor`` /
            ``vtkLZMADataCompressor``, UInt32 or UInt64 headers, either byte order. Cells other
            than tets and (with ``face_id``) triangles are ignored.
-``.msh``   Gmsh MSH **2.2 ASCII** is written (tet4 = type 4, tet10 = type 11). Gmsh's tet10
+``.msh``   Gmsh MSH **2.2 ASCII** is written (tet4 = type 4, tet10 = type 11), or 4.1 ASCII
+           on request (``msh_version``; entities per CAD face and solid, the same groups). Gmsh's tet10
            order is ``[n1, n2, n3, n4, m12, m23, m31, m14, m34, m24]``: our last two mid-edge
            nodes swapped. With groups, the CAD faces' triangles (type 2, or 9 with mid-edge
            nodes ``[a, b, c, m_ab, m_bc, m_ca]``) come first with physical and elementary tag
@@ -120,13 +121,14 @@ def tetgen_paths(path):
     return path + ".node", path + ".ele"
 
 
-def write_tet_mesh(path, mesh, groups=None):
+def write_tet_mesh(path, mesh, groups=None, msh_version="2.2"):
     """Write ``mesh`` to ``path`` (atomically); the format follows the extension.
 
     ``groups`` (optional, a :class:`~FemBspTet.kernel.mesh_types.MeshGroups`: the CAD faces' triangles
     and each tet's solid, with their names) become the format's named sets (see the module
     doc); :func:`surface_groups` makes them from a tagged surface. ``.node`` / ``.ele`` write
-    both TetGen files.
+    both TetGen files. ``msh_version``: "2.2" (read by every tool that reads MSH) or "4.1"
+    (Gmsh 4's own).
     """
     path = os.fspath(path)
     ext = _extension(path)
@@ -134,6 +136,11 @@ def write_tet_mesh(path, mesh, groups=None):
                ".node": _write_tetgen, ".ele": _write_tetgen, ".mesh": _write_medit}
     if ext not in writers:
         _unknown_extension(path, VOLUME_EXTENSIONS, "volume mesh")
+    if msh_version not in MSH_VERSIONS:
+        raise InputError(f"MSH version {msh_version!r} is not one we write; choose "
+                         + " or ".join(MSH_VERSIONS), where=path)
+    if ext == ".msh" and msh_version == "4.1":
+        writers[ext] = _write_msh41
     points, tets = _checked_mesh(mesh)
     sets = None if groups is None else _checked_groups(path, groups, points, tets)
     writers[ext](path, points, tets, sets)
@@ -668,6 +675,69 @@ _GMSH_NODES = {1: 2, 2: 3, 3: 4, 4: 4, 5: 8, 6: 6, 7: 5, 8: 3, 9: 6, 10: 9, 11: 
                13: 18, 14: 14, 15: 1, 16: 8, 17: 20, 18: 15, 19: 13, 20: 9, 21: 10, 22: 12,
                23: 15, 24: 15, 25: 21, 26: 4, 27: 5, 28: 6, 29: 20, 30: 35, 31: 56, 92: 64,
                93: 125}
+
+
+#: The MSH versions :func:`write_tet_mesh` writes.
+MSH_VERSIONS = ("2.2", "4.1")
+
+
+def _write_msh41(path, points, tets, sets):
+    """MSH 4.1 ASCII: one entity per CAD face (surface ``face + 1``) and per solid (volume
+    ``solid + 1``), each carrying the physical group of the same number and name; every node in
+    one block on the first volume (elements may use nodes of any entity)."""
+    k = tets.shape[1]
+    etype = _GMSH_TET4 if k == 4 else _GMSH_TET10
+    gtets = tets if k == 4 else tets[:, GMSH_TET10_ORDER]
+    solid = np.zeros(len(tets), dtype=np.int64) if sets is None else sets.solid
+    solids = np.unique(solid)
+    faces = np.zeros(0, dtype=np.int64) if sets is None else sets.faces()
+    solid_names = ["Solid1"] if sets is None else sets.solid_names
+
+    def box(rows):
+        p = points[np.unique(rows)]
+        return " ".join(repr(float(v)) for v in np.concatenate([p.min(axis=0), p.max(axis=0)]))
+
+    ntri = 0 if sets is None else len(sets.tri)
+    with atomic_output(path, "w") as out:
+        out.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n")
+        out.write(f"$Comments\n{_GENERATOR}\n$EndComments\n")
+        out.write(f"$PhysicalNames\n{len(faces) + len(solids)}\n")
+        for t in faces.tolist():
+            out.write(f'2 {t + 1} "{_msh_name(sets.face_names[t])}"\n')
+        for t in solids.tolist():
+            out.write(f'3 {t + 1} "{_msh_name(solid_names[t])}"\n')
+        out.write("$EndPhysicalNames\n$Entities\n")
+        out.write(f"0 0 {len(faces)} {len(solids)}\n")
+        for t in faces.tolist():
+            out.write(f"{t + 1} {box(sets.tri[sets.tags == t])} 1 {t + 1} 0\n")
+        for t in solids.tolist():
+            out.write(f"{t + 1} {box(tets[solid == t])} 1 {t + 1} 0\n")
+        out.write("$EndEntities\n")
+        n = len(points)
+        out.write(f"$Nodes\n1 {n} 1 {n}\n3 {int(solids[0]) + 1} 0 {n}\n")
+        out.write(_format_rows("%d\n", np.arange(1, n + 1).reshape(-1, 1)))
+        out.write(_format_rows("%r %r %r\n", points))
+        out.write("$EndNodes\n")
+        total = ntri + len(tets)
+        out.write(f"$Elements\n{len(faces) + len(solids)} {total} 1 {total}\n")
+        next_id = 1
+        if ntri:
+            ttype = _GMSH_TRI3 if sets.tri.shape[1] == 3 else _GMSH_TRI6
+            for t in faces.tolist():
+                rows = sets.tri[sets.tags == t]
+                out.write(f"2 {t + 1} {ttype} {len(rows)}\n")
+                ids = np.arange(next_id, next_id + len(rows))
+                out.write(_format_rows(" ".join(["%d"] * (rows.shape[1] + 1)) + "\n",
+                                       np.column_stack([ids, rows + 1])))
+                next_id += len(rows)
+        for t in solids.tolist():
+            rows = gtets[solid == t]
+            out.write(f"3 {t + 1} {etype} {len(rows)}\n")
+            ids = np.arange(next_id, next_id + len(rows))
+            out.write(_format_rows(" ".join(["%d"] * (k + 1)) + "\n",
+                                   np.column_stack([ids, rows + 1])))
+            next_id += len(rows)
+        out.write("$EndElements\n")
 
 
 def _write_msh(path, points, tets, sets):
