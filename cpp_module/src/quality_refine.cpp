@@ -1498,6 +1498,10 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
     out = make_second_order(m, options.projection, &so);
     st.midnodes_projected = so.projected;
     st.midnodes_straightened = so.straightened;
+    st.midnodes_relaxed_tets = so.relaxed;
+    st.midnodes_moved_interior = so.interior_moved;
+    st.midnodes_moved_surface = so.surface_moved;
+    st.lift_insertions = so.points_inserted;
   } else {
     out = m.to_tet_mesh();
   }

@@ -189,6 +189,10 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.midnodes_projected += rst.midnodes_projected;
     st.midnodes_straightened += rst.midnodes_straightened;
     st.curving_conflicts_left += rst.curving_conflicts_left;
+    st.midnodes_relaxed_tets += rst.midnodes_relaxed_tets;
+    st.midnodes_moved_interior += rst.midnodes_moved_interior;
+    st.midnodes_moved_surface += rst.midnodes_moved_surface;
+    st.lift_insertions += rst.lift_insertions;
     for (const auto& [pass, seconds] : rst.seconds_by_pass) st.refine_seconds_by_pass[pass] += seconds;
 
     // ---- 4. Merge this solid. ----

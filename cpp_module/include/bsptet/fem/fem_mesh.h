@@ -92,6 +92,11 @@ struct FemStats {
   std::int64_t projection_refused = 0;    ///< hook answers the quality stage refused (see cad_projection.h)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2, per solid (tet10.h)
   std::int64_t curving_conflicts_left = 0;  ///< order 2: tets the refinement left invalid when curved
+                                            ///< (interior mid-nodes straight), for the tet10 lift
+  /// Order 2, the tet10 lift (tet10.h): tets made valid by moving mid-nodes, interior mid-nodes
+  /// moved, boundary mid-nodes moved along their CAD face or edge, interior points inserted.
+  std::int64_t midnodes_relaxed_tets = 0, midnodes_moved_interior = 0, midnodes_moved_surface = 0;
+  std::int64_t lift_insertions = 0;
   // Merge (stage 4).
   std::int64_t midnodes_reconciled = 0;  ///< shared mid-nodes two solids placed differently (put on the chord)
   std::int64_t midnodes_straightened_at_merge = 0;  ///< mid-nodes put on their chord after that
