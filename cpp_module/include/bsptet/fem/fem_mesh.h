@@ -138,8 +138,13 @@ struct CadDistance {
 };
 
 /// Measures, for every node of every face triangle (corners and mid-nodes) and every CAD face whose
-/// triangles use it, cad::distance_to_face (the bounded face, as FreeCAD's getNodesByFace
-/// measures). Slow (one extrema search per pair): for tests and reports.
+/// triangles use it, the distance to the bounded face: the smaller of cad::distance_to_face
+/// (BRepExtrema_DistShapeShape, as FreeCAD's getNodesByFace measures; to the face's edges too)
+/// and the distance to CadProjector::to_face's nearest point of the trimmed surface. Both are
+/// distances to points of the face, so both bound the true distance from above; BRepExtrema can
+/// stop at a local minimum on B-spline faces (bottle.brep's thread flanks: 0.026 mm for a point
+/// the surface projection puts on the face). Slow (one extrema search per pair): for tests and
+/// reports.
 CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh);
 
 /// Meshes every solid of `model` (see the file comment). Throws InputError naming the option for
