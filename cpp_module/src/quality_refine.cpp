@@ -1495,7 +1495,9 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
   TetMesh out;
   if (options.order == 2) {
     SecondOrderStats so;
+    const auto lift_start = std::chrono::steady_clock::now();
     out = make_second_order(m, options.projection, &so);
+    st.seconds_by_pass["tet10"] += std::chrono::duration<double>(std::chrono::steady_clock::now() - lift_start).count();
     st.midnodes_projected = so.projected;
     st.midnodes_straightened = so.straightened;
     st.midnodes_relaxed_tets = so.relaxed;

@@ -502,8 +502,9 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats
 
 // A new interior point in each tet of `mesh` listed in `failing` (indices among the live tets, in
 // slot order: make_second_order's output order), so that no tet keeps the boundary faces, or the
-// boundary corners, that kept its curved element invalid. Candidates: the tet's centroid, then
-// the midpoints between it and each corner; the one whose new tets have the largest smallest
+// boundary corners, that kept its curved element invalid. Candidates: the tet's centroid and the
+// points a quarter and half of the way from it to each corner, edge midpoint and face centroid;
+// each is tried without being applied, and the one whose new tets have the largest smallest
 // dihedral angle goes in (RefineMesh::insert_point, the tet forced into the cavity), when that
 // angle is at least kMendFloorDeg. Returns the points inserted.
 std::int64_t insert_for_curving(RefineMesh& mesh, const std::vector<Index>& failing) {

@@ -160,7 +160,7 @@ struct RefineStats {
   std::int64_t lift_insertions = 0;
   double seconds = 0;
   /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,
-  /// separate_face_tags, curving (the passes that ran).
+  /// separate_face_tags, curving, tet10 (order 2: make_second_order) (the passes that ran).
   std::map<std::string, double> seconds_by_pass;
 };
 
