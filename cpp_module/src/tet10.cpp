@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <tuple>
 #include <vector>
 
 #include "bsptet/tet_shape.h"
@@ -320,12 +321,16 @@ class MidnodeRelaxer {
   const ProjectionHook& hook_;
 };
 
+// The hook's answers by (point, tag, other tag): a lift made again after insertions asks again
+// for the edges it kept.
+using ProjectionCache = std::map<std::tuple<double, double, double, std::int32_t, std::int32_t>, Vec3>;
+
 // One lift of `mesh` to 10 nodes: projection, relaxation (MidnodeRelaxer), then, with
 // `straighten`, the mid-nodes of the tets still not certified back on their chords until every
 // curved tet is certified. Without `straighten`, `failing` receives the tets (output order) still
 // not certified after the relaxation; when there are any, the result is not to be used.
-TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats& st, bool straighten,
-                  std::vector<Index>* failing) {
+TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache& cache, SecondOrderStats& st,
+                  bool straighten, std::vector<Index>* failing) {
   std::vector<Index> renum;
   TetMesh lin = mesh.to_tet_mesh(&renum);
 
@@ -375,7 +380,10 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats
     auto it = boundary_edge_tags.find(edges[i]);
     if (hook && it != boundary_edge_tags.end()) {
       const auto tags = it->second;
-      const Vec3 q = hook(p, tags[0], tags[1] != tags[0] ? tags[1] : -1);
+      const std::int32_t other = tags[1] != tags[0] ? tags[1] : -1;
+      auto [at, fresh] = cache.try_emplace({p.x, p.y, p.z, tags[0], other});
+      if (fresh) at->second = hook(p, tags[0], other);
+      const Vec3 q = at->second;
       if (std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && !taken.count({q.x, q.y, q.z})) {
         curved[i] = q.x != p.x || q.y != p.y || q.z != p.z;  // a straight edge of the surface: 0
         p = q;
@@ -562,10 +570,11 @@ std::int64_t insert_for_curving(RefineMesh& mesh, const std::vector<Index>& fail
 TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats* stats) {
   SecondOrderStats st;
   std::int64_t inserted = 0;
+  ProjectionCache cache;
   for (int round = 0; hook && round < kMendRounds; ++round) {
     std::vector<Index> failing;
     st = SecondOrderStats{};
-    TetMesh out = lift_once(mesh, hook, st, false, &failing);
+    TetMesh out = lift_once(mesh, hook, cache, st, false, &failing);
     if (failing.empty()) {
       st.points_inserted = inserted;
       if (stats) *stats = st;
@@ -576,7 +585,7 @@ TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOr
     if (made == 0) break;
   }
   st = SecondOrderStats{};
-  TetMesh out = lift_once(mesh, hook, st, true, nullptr);
+  TetMesh out = lift_once(mesh, hook, cache, st, true, nullptr);
   st.points_inserted = inserted;
   if (stats) *stats = st;
   return out;
