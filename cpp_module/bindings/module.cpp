@@ -189,6 +189,10 @@ py::tuple mesh_cad(const std::function<cad::CadModel()>& read, double size, doub
   d["midnodes_projected"] = st.midnodes_projected;
   d["midnodes_straightened"] = st.midnodes_straightened;
   d["curving_conflicts_left"] = st.curving_conflicts_left;
+  d["midnodes_relaxed_tets"] = st.midnodes_relaxed_tets;
+  d["midnodes_moved_interior"] = st.midnodes_moved_interior;
+  d["midnodes_moved_surface"] = st.midnodes_moved_surface;
+  d["lift_insertions"] = st.lift_insertions;
   d["midnodes_reconciled"] = st.midnodes_reconciled;
   d["midnodes_straightened_at_merge"] = st.midnodes_straightened_at_merge;
   d["nodes"] = st.nodes;
@@ -480,6 +484,10 @@ PYBIND11_MODULE(_bsptet, m) {
         d["midnodes_straightened"] = st.midnodes_straightened;
         d["curving_lifts"] = st.curving_lifts;
         d["curving_conflicts_left"] = st.curving_conflicts_left;
+        d["midnodes_relaxed_tets"] = st.midnodes_relaxed_tets;
+        d["midnodes_moved_interior"] = st.midnodes_moved_interior;
+        d["midnodes_moved_surface"] = st.midnodes_moved_surface;
+        d["lift_insertions"] = st.lift_insertions;
         d["seconds"] = st.seconds;
         d["seconds_by_pass"] = st.seconds_by_pass;
         return py::make_tuple(points_array(out), tets_array(out), d);

@@ -541,8 +541,8 @@ class Refiner {
   // ---- Phase 4: room for curved tet10 elements -----------------------------------------------
   // With a projection hook and order 2, each boundary mid-node goes onto the true surface, off its
   // chord by the chord's sag. A tet whose interior apex stands lower over its boundary face than
-  // that sag becomes an invalid curved element (make_second_order would straighten its mid-nodes,
-  // leaving them off the CAD face). Such apexes (interior Steiner points only) are lifted towards
+  // that sag becomes an invalid curved element with straight interior mid-nodes (make_second_order
+  // then has to move mid-nodes or insert a point, tet10.h). Such apexes (interior Steiner points only) are lifted towards
   // the height of a regular tet over the face, when every tet around stays positive (exact), the
   // number of invalid curved elements around goes down, and no tet around drops below
   // min(1 degree, the worst before): a valid curved mesh is worth a worse linear angle there.
@@ -1509,9 +1509,15 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
   TetMesh out;
   if (options.order == 2) {
     SecondOrderStats so;
+    const auto lift_start = std::chrono::steady_clock::now();
     out = make_second_order(m, options.projection, &so);
+    st.seconds_by_pass["tet10"] += std::chrono::duration<double>(std::chrono::steady_clock::now() - lift_start).count();
     st.midnodes_projected = so.projected;
     st.midnodes_straightened = so.straightened;
+    st.midnodes_relaxed_tets = so.relaxed;
+    st.midnodes_moved_interior = so.interior_moved;
+    st.midnodes_moved_surface = so.surface_moved;
+    st.lift_insertions = so.points_inserted;
   } else {
     out = m.to_tet_mesh();
   }

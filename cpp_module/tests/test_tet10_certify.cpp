@@ -10,7 +10,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <random>
+#include <vector>
 
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesher.h"
@@ -482,4 +484,83 @@ TEST(Tet10Certify, MakeSecondOrderLeavesOnlyCertifiedElements) {
               static_cast<long long>(st.midnodes_straightened), certified);
   EXPECT_EQ(certified, m.num_tets());
   EXPECT_GT(st.midnodes_projected, 0);
+}
+
+// make_second_order straight on the core's tets of a coarse hexagonal tube (radii 6 and 10,
+// height 4): the inner wall is concave, so its mid-nodes go into the solid by the chords' sag
+// (0.80), and many of the core's flat tets over it are invalid once curved. The lift mends them by
+// moving mid-nodes (interior ones, and boundary ones along the cylinders through the hook) and,
+// where that is not enough, interior points: every element certified, none straightened, and
+// every boundary mid-node on its cylinder or plane.
+TEST(Tet10Certify, MakeSecondOrderMendsCurvedConflictsWithoutStraightening) {
+  const int n = 6;
+  const double outer = 10, inner = 6;
+  const double pi = 3.14159265358979323846;
+  SurfaceMesh s;
+  for (int z = 0; z < 2; ++z)
+    for (double r : {outer, inner})
+      for (int i = 0; i < n; ++i) {
+        const double a = 2 * pi * i / n;
+        s.xyz.insert(s.xyz.end(), {r * std::cos(a), r * std::sin(a), 4.0 * z});
+      }
+  auto v = [&](int z, int ring, int i) { return 2 * n * z + n * ring + (i % n); };
+  for (int i = 0; i < n; ++i) {
+    const int j = i + 1;
+    s.tri.insert(s.tri.end(), {v(0, 0, i), v(0, 0, j), v(1, 0, j), v(0, 0, i), v(1, 0, j), v(1, 0, i)});  // outer
+    s.tri.insert(s.tri.end(), {v(0, 1, i), v(1, 1, j), v(0, 1, j), v(0, 1, i), v(1, 1, i), v(1, 1, j)});  // inner
+    s.tri.insert(s.tri.end(), {v(1, 0, i), v(1, 0, j), v(1, 1, j), v(1, 0, i), v(1, 1, j), v(1, 1, i)});  // top
+    s.tri.insert(s.tri.end(), {v(0, 0, i), v(0, 1, j), v(0, 0, j), v(0, 0, i), v(0, 1, i), v(0, 1, j)});  // bottom
+    s.tag.insert(s.tag.end(), {0, 0, 1, 1, 2, 2, 3, 3});
+  }
+  auto on_cylinder = [](const Vec3& p, double r) {
+    const double d = std::hypot(p.x, p.y);
+    return Vec3{r * p.x / d, r * p.y / d, p.z};
+  };
+  const ProjectionHook hook = [&](const Vec3& p, std::int32_t tag, std::int32_t other) {
+    const std::int32_t t = other >= 0 && other < tag ? other : tag;  // a cylinder when one is
+    if (t == 0) return on_cylinder(p, outer);
+    if (t == 1) return on_cylinder(p, inner);
+    return p;  // the planes: the rounded midpoint is on them
+  };
+  const TetMesh core = tetrahedralize(s, MeshOptions{});
+  RefineMesh mesh(s, core, hook);
+  SecondOrderStats st;
+  const TetMesh m = make_second_order(mesh, hook, &st);
+  ASSERT_EQ(m.nodes_per_tet, 10);
+  std::printf("tube tet10: %d tets, %lld projected, %lld tets mended by moves, %lld points inserted, %lld straightened\n",
+              static_cast<int>(m.num_tets()), static_cast<long long>(st.projected), static_cast<long long>(st.relaxed),
+              static_cast<long long>(st.points_inserted), static_cast<long long>(st.straightened));
+  EXPECT_GT(st.relax_tried, 0);  // the case this test is about
+  EXPECT_EQ(st.straightened, 0);
+  for (Index t = 0; t < m.num_tets(); ++t) {
+    double x[30];
+    for (int k = 0; k < 10; ++k)
+      for (int c = 0; c < 3; ++c) x[3 * k + c] = m.xyz[static_cast<std::size_t>(3 * m.tet[static_cast<std::size_t>(10 * t + k)] + c)];
+    EXPECT_EQ(certify_tet10(x), Tet10Validity::kCertified) << "tet " << t;
+  }
+  // Boundary mid-nodes (no point was added, so the boundary edges are the input's): on their
+  // cylinder (tags 0 and 1: radii 10 and 5) and on their plane (tags 2 and 3: z = 4 and 0).
+  std::map<std::array<Index, 2>, std::vector<std::int32_t>> edge_tags;
+  for (Index f = 0; f < s.num_triangles(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = s.tri[static_cast<std::size_t>(3 * f + k)], b = s.tri[static_cast<std::size_t>(3 * f + (k + 1) % 3)];
+      edge_tags[{std::min(a, b), std::max(a, b)}].push_back(s.tag[static_cast<std::size_t>(f)]);
+    }
+  static const int kMid[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+  std::int64_t checked = 0;
+  for (Index t = 0; t < m.num_tets(); ++t) {
+    const Index* q = &m.tet[static_cast<std::size_t>(10 * t)];
+    for (int e = 0; e < 6; ++e) {
+      const Index a = q[kMid[e][0]], b = q[kMid[e][1]];
+      auto it = edge_tags.find({std::min(a, b), std::max(a, b)});
+      if (it == edge_tags.end()) continue;
+      const Vec3 p = m.point(q[4 + e]);
+      for (std::int32_t tag : it->second) {
+        if (tag <= 1) EXPECT_NEAR(std::hypot(p.x, p.y), tag == 0 ? outer : inner, 1e-12) << "tet " << t << " mid-node " << e;
+        if (tag >= 2) EXPECT_EQ(p.z, tag == 2 ? 4.0 : 0.0) << "tet " << t << " mid-node " << e;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 0);
 }

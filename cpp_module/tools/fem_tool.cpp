@@ -65,6 +65,10 @@ int main(int argc, char** argv) {
                 (long long)st.midnodes_projected, (long long)st.midnodes_straightened,
                 (long long)st.curving_conflicts_left, (long long)st.midnodes_reconciled,
                 (long long)st.midnodes_straightened_at_merge);
+    std::printf("  tet10 lift: tets mended by moving mid-nodes %lld (interior mid-nodes moved %lld, boundary "
+                "mid-nodes moved along the CAD %lld), points inserted %lld\n",
+                (long long)st.midnodes_relaxed_tets, (long long)st.midnodes_moved_interior,
+                (long long)st.midnodes_moved_surface, (long long)st.lift_insertions);
     std::printf("  mesh: nodes %lld (corners %lld) tets %lld face triangles %lld\n", (long long)st.nodes,
                 (long long)st.corner_nodes, (long long)st.tets, (long long)st.boundary_triangles);
     std::printf("  dihedral: min %.2f deg, median per-tet worst %.2f deg, tets under 10 deg %.2f%%\n",

@@ -151,7 +151,13 @@ struct RefineStats {
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
   std::int64_t curving_lifts = 0;           ///< order 2 with a hook: interior points lifted so that
                                             ///< curved elements stay valid (quality_refine.cpp)
-  std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element was still invalid
+  std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element (interior mid-nodes
+                                            ///< straight) was still invalid; the tet10 lift mends them
+  /// Order 2 with a hook, the tet10 lift (tet10.h make_second_order): tets made valid by moving
+  /// mid-nodes, interior mid-nodes moved off their chords, boundary mid-nodes moved along their
+  /// CAD face or edge, interior points inserted for tets the moves could not mend.
+  std::int64_t midnodes_relaxed_tets = 0, midnodes_moved_interior = 0, midnodes_moved_surface = 0;
+  std::int64_t lift_insertions = 0;
   /// Smallest min dihedral angle of the linear tets (degrees) at three points of the stage: when
   /// the optimization (and separate_face_tags) is done; after the room made for curved elements
   /// (order 2 with a hook; else the same); and at the end (the output's corner tets). Where the
@@ -160,7 +166,7 @@ struct RefineStats {
   double worst_deg_optimized = 180, worst_deg_curving_room = 180, worst_deg = 180;
   double seconds = 0;
   /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,
-  /// separate_face_tags, curving (the passes that ran).
+  /// separate_face_tags, curving, tet10 (order 2: make_second_order) (the passes that ran).
   std::map<std::string, double> seconds_by_pass;
 };
 

@@ -143,6 +143,8 @@ class RefineMesh {
   /// not input points, and a fixed face has none), so its boundary faces stay the input triangles. This is what keeps a face shared by two solids
   /// conforming when each solid is refined on its own.
   void set_fixed_tags(std::vector<std::int32_t> tags);
+  /// The tags set_fixed_tags kept, sorted.
+  const std::vector<std::int32_t>& fixed_tags() const { return fixed_tags_; }
 
   // ---- Operations: each checked exactly, applied only when valid --------------------------------
   /// Splits edge (u, v) at a point near its midpoint (see the file comment for the surface rules).

@@ -7,11 +7,28 @@
 // two parent input triangles (other tag -1 when both have the same tag), so that mid-nodes lie on
 // the true curved surface; without a hook they stay at the midpoint (on the facet up to rounding).
 // Every tet must be certified valid (certify_tet10: det J > 0 over the whole element, proved with
-// Bezier bounds and rounding-error bounds). The hook-placed mid-nodes of a tet that is not certified
-// are put back on their chords (the rounded midpoint), repeatedly, until every tet that still has
-// a curved mid-node is certified. This straightening is the simple mend: it leaves those mid-nodes
-// off the true surface; moving them only part of the way, or moving interior nodes, would keep
-// more of the curvature and is not done here. Node order: types.h (n1..n4 m12 m23 m31 m14 m24
+// Bezier bounds and rounding-error bounds). A curved tet that is not certified is mended, in
+// this order:
+//  1. Mid-node relaxation: its mid-nodes move (then also those of the tets that share one with
+//     it) to lower the shortfall of the elements' scaled Bezier coefficients (c_a over 6 times the
+//     straight volume) below 0.1, by Levenberg-Marquardt steps: an interior edge's mid-node
+//     anywhere (the interior edges then follow the boundary's curvature), a hook-placed
+//     mid-node along its CAD face (in its edge's plane and the face triangle's, then put back on
+//     the face by the hook) or along its CAD edge (along the chord, then back on the edge by the
+//     hook), so it stays on the CAD geometry. Mid-nodes on faces kept as input
+//     (RefineMesh::set_fixed_tags: faces shared with another solid) do not move. The moves are
+//     kept when the tet is then certified and no tet around that was certified stops being so.
+//     What this mends: an interior apex too close to a curved face (the interior mid-nodes bend
+//     with it) and a needle face whose curved long edge tilts past its short one at a corner (the
+//     mid-node slides along the CAD edge, which changes the tangent there).
+//  2. A new interior point (RefineMesh::insert_point, the tet in its cavity) for each tet the
+//     relaxation leaves invalid, then the lift again (at most 3 rounds): a tet with two boundary
+//     faces on two tangent-continuous CAD faces has its three corner tangents in one plane
+//     whatever its mid-nodes on the surface; the point gives it interior edges.
+//  3. Last resort: the mid-nodes of the tets still not certified go back on their chords
+//     (repeatedly, until every tet that still has a curved mid-node is certified), leaving those
+//     boundary mid-nodes off the CAD face; SecondOrderStats::straightened counts them.
+// Node order: types.h (n1..n4 m12 m23 m31 m14 m24
 // m34); the linear points first, then the mid-nodes in sorted edge order.
 //
 // Validity of a 10-node tet (after Johnen, Remacle and Geuzaine, "Geometrical validity of
@@ -44,9 +61,16 @@ struct SecondOrderStats {
                                   ///< certified; only mid-nodes the hook had moved off the chord count)
   std::int64_t not_certified = 0;  ///< curved tets found not certified (each straightened)
   std::int64_t curved_tets = 0;    ///< tets left with a curved mid-node, each certified
+  std::int64_t relax_tried = 0;    ///< tets not certified once projected, given to the relaxation
+  std::int64_t relaxed = 0;        ///< of which certified by moving interior mid-nodes
+  std::int64_t interior_moved = 0;  ///< interior mid-nodes left off their chords
+  std::int64_t surface_moved = 0;   ///< boundary mid-nodes moved along their CAD face or edge
+  std::int64_t points_inserted = 0;  ///< interior points added to the linear mesh for curving
 };
 
-/// Builds the 10-node mesh of `mesh`'s live tets. `hook` may be empty.
+/// Builds the 10-node mesh of `mesh`'s live tets. `hook` may be empty (then every mid-node is a
+/// midpoint and nothing is mended). With a hook, interior points may be inserted into `mesh`
+/// (step 2 above); the result's corners are then `mesh.to_tet_mesh()`'s after them.
 TetMesh make_second_order(RefineMesh& mesh, const ProjectionHook& hook, SecondOrderStats* stats = nullptr);
 
 /// The 20 multi-indices (a0, a1, a2, a3), a0 + a1 + a2 + a3 = 3, of the cubic Bernstein basis on

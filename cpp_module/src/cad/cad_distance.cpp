@@ -18,6 +18,7 @@
 #include <TopoDS_Vertex.hxx>
 #include <gp_Pnt.hxx>
 
+#include "bsptet/cad/cad_projection.h"
 #include "bsptet/errors.h"
 
 namespace bsptet::cad {
@@ -37,15 +38,27 @@ struct Box {
   }
 };
 
-double measure(const CadModel& model, int face, const Vec3& p) {
+/// The smaller of two distances to real points of the face (both bound the true distance from
+/// above): BRepExtrema's (what FreeCAD's distToShape gives; it can stop at a local minimum on a
+/// B-spline face) and the projection onto the trimmed surface (CadProjector::to_face).
+double measure(const CadModel& model, CadProjector& projector, int face, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
   try {
     const TopoDS_Vertex vertex = BRepBuilderAPI_MakeVertex(gp_Pnt(p.x, p.y, p.z));
     BRepExtrema_DistShapeShape extrema(model.faces(face + 1), vertex);
-    if (extrema.IsDone() && extrema.NbSolution() >= 1) return extrema.Value();
+    if (extrema.IsDone() && extrema.NbSolution() >= 1) best = extrema.Value();
   } catch (const Standard_Failure&) {
   }
-  throw MeshingError(ErrorCode::kInternal, "cad_distance", face,
-                     model.source + ": OpenCASCADE could not measure a distance to Face" + std::to_string(face + 1));
+  try {
+    const Vec3 q = projector.to_face(p, face);
+    const double dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
+    best = std::min(best, std::sqrt(dx * dx + dy * dy + dz * dz));
+  } catch (const Error&) {
+  }
+  if (!std::isfinite(best))
+    throw MeshingError(ErrorCode::kInternal, "cad_distance", face,
+                       model.source + ": OpenCASCADE could not measure a distance to Face" + std::to_string(face + 1));
+  return best;
 }
 
 }  // namespace
@@ -70,6 +83,7 @@ FaceDistances distances_to_faces(const CadModel& model, const std::vector<Vec3>&
     Box& box = boxes[static_cast<std::size_t>(f)];
     b.Get(box.lo[0], box.lo[1], box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
   }
+  CadProjector projector(model);
   std::vector<int> order(static_cast<std::size_t>(nf));
   std::vector<double> box_distance(static_cast<std::size_t>(nf));
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -79,7 +93,7 @@ FaceDistances distances_to_faces(const CadModel& model, const std::vector<Vec3>&
       throw InputError(ErrorCode::kBadArgument, "cad_distance", static_cast<std::int64_t>(i),
                        "point " + std::to_string(i) + ": the model has no Face" + std::to_string(given + 1));
     if (given >= 0) {
-      out.distance[i] = measure(model, given, p);
+      out.distance[i] = measure(model, projector, given, p);
       out.face[i] = given;
       continue;
     }
@@ -94,7 +108,7 @@ FaceDistances distances_to_faces(const CadModel& model, const std::vector<Vec3>&
     int best_face = -1;
     for (const int f : order) {
       if (box_distance[static_cast<std::size_t>(f)] > best) break;
-      const double d = measure(model, f, p);
+      const double d = measure(model, projector, f, p);
       if (d < best) {
         best = d;
         best_face = f;

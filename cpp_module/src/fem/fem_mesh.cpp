@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "bsptet/cad/cad_projection.h"
 #include "bsptet/cad/cad_surface.h"
 #include "bsptet/errors.h"
 #include "bsptet/mesher.h"
@@ -192,6 +193,10 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.refine_worst_deg_optimized = std::min(st.refine_worst_deg_optimized, rst.worst_deg_optimized);
     st.refine_worst_deg_curving_room = std::min(st.refine_worst_deg_curving_room, rst.worst_deg_curving_room);
     st.refine_worst_deg = std::min(st.refine_worst_deg, rst.worst_deg);
+    st.midnodes_relaxed_tets += rst.midnodes_relaxed_tets;
+    st.midnodes_moved_interior += rst.midnodes_moved_interior;
+    st.midnodes_moved_surface += rst.midnodes_moved_surface;
+    st.lift_insertions += rst.lift_insertions;
     for (const auto& [pass, seconds] : rst.seconds_by_pass) st.refine_seconds_by_pass[pass] += seconds;
 
     // ---- 4. Merge this solid. ----
@@ -369,8 +374,10 @@ CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh
     if (static_cast<int>(i % static_cast<std::size_t>(npt)) < 4) is_corner[static_cast<std::size_t>(mesh.mesh.tet[i])] = 1;
   CadDistance d;
   double worst = -1;
+  cad::CadProjector projector(model);
   for (const auto& [node, face] : pairs) {
-    const double dist = cad::distance_to_face(model, face, mesh.mesh.point(node));
+    const Vec3 p = mesh.mesh.point(node), q = projector.to_face(p, face);
+    const double dist = std::min(cad::distance_to_face(model, face, p), std::sqrt(squared_distance(p, q)));
     double& max = is_corner[static_cast<std::size_t>(node)] ? d.max_corner : d.max_midnode;
     max = std::max(max, dist);
     if (dist > worst) {

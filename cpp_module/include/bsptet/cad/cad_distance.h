@@ -6,8 +6,10 @@
 //
 // A point with a known face (0-based, as CadModel numbers them) is measured to that bounded face;
 // one with face -1 to every face whose bounding box could hold a nearer point, and the nearest
-// wins. Distances are BRepExtrema_DistShapeShape's (what FreeCAD's FemMesh.getNodesByFace
-// compares with the face's tolerance), in model units.
+// wins. A distance is the smaller of BRepExtrema_DistShapeShape's (what FreeCAD's distToShape
+// gives) and the projection's onto the trimmed surface (cad_projection.h): both are distances to
+// real points of the face, and BRepExtrema alone can stop at a local minimum on a B-spline face.
+// Model units.
 #pragma once
 
 #include <vector>

@@ -92,6 +92,11 @@ struct FemStats {
   std::int64_t projection_refused = 0;    ///< hook answers the quality stage refused (see cad_projection.h)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2, per solid (tet10.h)
   std::int64_t curving_conflicts_left = 0;  ///< order 2: tets the refinement left invalid when curved
+                                            ///< (interior mid-nodes straight), for the tet10 lift
+  /// Order 2, the tet10 lift (tet10.h): tets made valid by moving mid-nodes, interior mid-nodes
+  /// moved, boundary mid-nodes moved along their CAD face or edge, interior points inserted.
+  std::int64_t midnodes_relaxed_tets = 0, midnodes_moved_interior = 0, midnodes_moved_surface = 0;
+  std::int64_t lift_insertions = 0;
   /// The refinement's worst dihedral angle (degrees, least over the solids) when its optimization
   /// is done, after it made room for curved elements, and at its end (RefineStats::worst_deg_*);
   /// the last equals min_dihedral_deg (the merge keeps the refined corners).
@@ -137,8 +142,13 @@ struct CadDistance {
 };
 
 /// Measures, for every node of every face triangle (corners and mid-nodes) and every CAD face whose
-/// triangles use it, cad::distance_to_face (the bounded face, as FreeCAD's getNodesByFace
-/// measures). Slow (one extrema search per pair): for tests and reports.
+/// triangles use it, the distance to the bounded face: the smaller of cad::distance_to_face
+/// (BRepExtrema_DistShapeShape, as FreeCAD's getNodesByFace measures; to the face's edges too)
+/// and the distance to CadProjector::to_face's nearest point of the trimmed surface. Both are
+/// distances to points of the face, so both bound the true distance from above; BRepExtrema can
+/// stop at a local minimum on B-spline faces (bottle.brep's thread flanks: 0.026 mm for a point
+/// the surface projection puts on the face). Slow (one extrema search per pair): for tests and
+/// reports.
 CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh);
 
 /// Meshes every solid of `model` (see the file comment). Throws InputError naming the option for
