@@ -59,7 +59,11 @@ def test_session_ran_every_step(facts):
 
 def test_command_in_fem_toolbar_menu_and_own_workbench(facts):
     assert facts["workbench_registered"] and facts["command_registered"]
-    assert facts["bsptet_toolbar_in_fem"] == ["FEM_MeshBspTetFromShape"]
+    if facts["workbench_manipulators"]:  # FreeCAD 1.x: right after Gmsh in FEM's own toolbar
+        tools = facts["fem_toolbar_with_gmsh"]
+        assert tools.index("FEM_MeshBspTetFromShape") == tools.index("FEM_MeshGmshFromShape") + 1
+    else:  # FreeCAD 0.20/0.21: a toolbar of its own in FEM
+        assert facts["bsptet_toolbar_in_fem"] == ["FEM_MeshBspTetFromShape"]
     entries = facts["fem_mesh_menu_entries"]
     assert "FEM_MeshBspTetFromShape" in entries
     assert entries.index("FEM_MeshBspTetFromShape") == entries.index("FEM_MeshGmshFromShape") + 1
@@ -69,7 +73,9 @@ def test_command_in_fem_toolbar_menu_and_own_workbench(facts):
 
 
 def test_command_creates_object_in_analysis_and_opens_panel(facts):
-    assert facts["object_type"] == "Fem::FemMeshObjectPython"
+    # FreeCAD 1.x: a shape-based FEM mesh object (link Shape); 0.20/0.21: a FEM mesh object
+    assert facts["object_type"] in ("Fem::FemMeshShapeBaseObjectPython", "Fem::FemMeshObjectPython")
+    assert facts["object_type"] == facts["expected_object_type"]
     assert facts["proxy_type"] == "Fem::FemMeshBspTet"
     assert facts["part_link"] == "Block"
     assert facts["view_provider"] == "VPMeshBspTet"
