@@ -141,6 +141,7 @@ def _migrate_part_to_shape(obj):
     if PART_LINK not in obj.PropertiesList or SHAPE_LINK in obj.PropertiesList:
         return False
     part = obj.getPropertyByName(PART_LINK)
+    obj.setPropertyStatus(PART_LINK, "-LockDynamic")
     obj.removeProperty(PART_LINK)
     obj.addProperty("App::PropertyLinkGlobal", SHAPE_LINK, "FEM Mesh",
                     "The solid (Part) the mesh is made from")
