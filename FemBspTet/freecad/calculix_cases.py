@@ -75,7 +75,7 @@ def build_case(doc, name):
     doc.recompute()
 
     analysis = ObjectsFem.makeAnalysis(doc, "Analysis")
-    # FEM's ccxtools solver object: makeSolverCalculiXCcxTools on FreeCAD 1.x, its old spelling on 0.20
+    # FEM's ccxtools solver: makeSolverCalculiXCcxTools on FreeCAD 1.x, the old spelling on 0.20
     make_solver = getattr(ObjectsFem, "makeSolverCalculiXCcxTools", None) or \
         ObjectsFem.makeSolverCalculixCcxTools
     solver = make_solver(doc, "CalculiXccxTools")
