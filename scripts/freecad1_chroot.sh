@@ -71,9 +71,14 @@ cleanup() {
   done
   MOUNTED=()
 }
+CHILD=
+stop() {  # on INT/TERM: end the command running in the chroot, then exit (cleanup runs)
+  if [ -n "$CHILD" ]; then kill -TERM "$CHILD" 2>/dev/null; wait "$CHILD" 2>/dev/null; fi
+  exit "$1"
+}
 trap cleanup EXIT
-trap 'exit 130' INT
-trap 'exit 143' TERM
+trap 'stop 130' INT
+trap 'stop 143' TERM
 
 mount_into() {  # mount_into TARGET MOUNT-ARGS...: mount unless something is mounted there already
   local target=$CHROOT$1
@@ -94,13 +99,13 @@ mount_system() {
   mount_into /dev/pts --bind /dev/pts
 }
 
-in_chroot() {  # in_chroot CMD...: run CMD in the chroot with a clean environment
-  # FEMBSPTET_CORE_TOOL and FEMBSPTET_BUILD_DIR: the chroot's build, never the host's build/
-  env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin HOME=/root LANG=C.UTF-8 \
-    TERM="${TERM:-dumb}" DEBIAN_FRONTEND=noninteractive \
-    FEMBSPTET_BUILD_DIR="$INSIDE/$BUILD" FEMBSPTET_CORE_TOOL="$INSIDE/$BUILD/cpp_module/bsptet_mesh" \
-    "${NICE[@]}" chroot "$CHROOT" "$@"
-}
+# A command in the chroot with a clean environment; FEMBSPTET_CORE_TOOL and FEMBSPTET_BUILD_DIR
+# name the chroot's build, never the host's build/.
+CHROOT_CMD=(env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin HOME=/root
+  LANG=C.UTF-8 TERM="${TERM:-dumb}" DEBIAN_FRONTEND=noninteractive
+  FEMBSPTET_BUILD_DIR="$INSIDE/$BUILD" FEMBSPTET_CORE_TOOL="$INSIDE/$BUILD/cpp_module/bsptet_mesh"
+  "${NICE[@]}" chroot "$CHROOT")
+in_chroot() { "${CHROOT_CMD[@]}" "$@"; }
 
 # ---- 1. the base system ------------------------------------------------------------------------
 if [ -f "$CHROOT/.fembsptet-base-complete" ]; then
@@ -194,7 +199,12 @@ say "built FemBspTet/_bsptet$suffix"
 # ---- 5. the command ----------------------------------------------------------------------------------
 if ((${#CMD[@]})); then
   say "running in the chroot: ${CMD[*]}"
+  # in the background and waited for, so that INT/TERM reach the traps at once
+  # (a simple command: its process becomes the command itself, which TERM then reaches)
+  "${CHROOT_CMD[@]}" sh -c 'cd "$0" && exec "$@"' "$INSIDE" "${CMD[@]}" &
+  CHILD=$!
   status=0
-  in_chroot sh -c 'cd "$0" && exec "$@"' "$INSIDE" "${CMD[@]}" || status=$?
+  wait "$CHILD" || status=$?
+  CHILD=
   exit $status
 fi
