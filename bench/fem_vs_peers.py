@@ -253,7 +253,7 @@ def worker_gmsh(part, h, order, out):
     feature = doc.addObject("Part::Feature", "Part")
     feature.Shape = Part.read(part)
     mesh_obj = ObjectsFem.makeMeshGmsh(doc, "MeshGmsh")
-    mesh_obj.Part = feature
+    setattr(mesh_obj, "Shape" if "Shape" in mesh_obj.PropertiesList else "Part", feature)  # 1.x: Shape
     mesh_obj.CharacteristicLengthMax = h
     mesh_obj.ElementOrder = "2nd" if order == 2 else "1st"
     doc.recompute()

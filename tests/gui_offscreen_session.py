@@ -34,6 +34,8 @@ try:
     import FreeCADGui
     from PySide import QtGui
 
+    from FemBspTet.freecad.mesher_object import object_type, set_source, source_of
+
     facts["gui_up"] = bool(FreeCAD.GuiUp)
 
     @step("workbench and command")
@@ -46,6 +48,9 @@ try:
                 for t in mw.findChildren(QtGui.QToolBar)}
         facts["fem_toolbars"] = sorted(bars)
         facts["bsptet_toolbar_in_fem"] = bars.get("BspTet")
+        facts["fem_toolbar_with_gmsh"] = next(
+            (names for names in bars.values() if "FEM_MeshGmshFromShape" in names), None)
+        facts["workbench_manipulators"] = hasattr(FreeCADGui, "addWorkbenchManipulator")
         from FemBspTet.gui import commands
 
         for _ in range(5):
@@ -86,8 +91,9 @@ try:
         obj = doc.getObject("MeshBspTet")
         state["obj"] = obj
         facts["object_type"] = obj.TypeId
+        facts["expected_object_type"] = object_type(doc)
         facts["proxy_type"] = obj.Proxy.Type
-        facts["part_link"] = obj.Part.Name
+        facts["part_link"] = source_of(obj).Name
         facts["view_provider"] = type(obj.ViewObject.Proxy).__name__
         facts["in_analysis"] = obj in analysis.Group
         import __main__
@@ -155,7 +161,7 @@ try:
         shell.Shape = Part.Shell(Part.makeBox(5, 5, 5).Faces[:5])
         doc.recompute()
         before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount)
-        obj.Part = shell
+        set_source(obj, shell)
         tp.sb_max.setValue(0.0)
         tp.start_meshing()
         tp.wait(120)
@@ -163,7 +169,7 @@ try:
         facts["failure_status_property"] = obj.MeshStatus
         facts["mesh_kept_after_failure"] = before == (obj.FemMesh.NodeCount,
                                                       obj.FemMesh.VolumeCount)
-        obj.Part = block
+        set_source(obj, block)
         doc.removeObject("OpenShell")
 
     @step("dialog buttons")
@@ -194,7 +200,7 @@ try:
         facts["reloaded_nodes_equal"] = o2.FemMesh.NodeCount == nodes and nodes > 0
         facts["reloaded_proxy_type"] = getattr(o2.Proxy, "Type", None)
         facts["reloaded_view_provider"] = type(o2.ViewObject.Proxy).__name__
-        facts["reloaded_part"] = o2.Part.Name if o2.Part else None
+        facts["reloaded_part"] = source_of(o2).Name if source_of(o2) else None
         FreeCAD.closeDocument(doc2.Name)
 
     @step("preferences page")

@@ -35,9 +35,14 @@ def facts(tmp_path_factory):
     env = dict(os.environ, HOME=str(home), QT_QPA_PLATFORM="offscreen")
     env.pop("PYTHONPATH", None)  # the addon must load as a Mod, not from our path
     # The Start page's QtWebEngine aborts offscreen: start in the Part workbench instead.
+    # FreeCAD 1.x's notification area deadlocks offscreen (its pop-up's raise() makes Qt warn,
+    # and the warning comes back into the notification area): notifications off.
     subprocess.run(["freecadcmd", "-c",
                     "import FreeCAD; FreeCAD.ParamGet('User parameter:BaseApp/Preferences/"
-                    "General').SetString('AutoloadModule', 'PartWorkbench')"],
+                    "General').SetString('AutoloadModule', 'PartWorkbench'); "
+                    "g = FreeCAD.ParamGet('User parameter:BaseApp/Preferences/NotificationArea'); "
+                    "g.SetBool('NotificationAreaEnabled', False); "
+                    "g.SetBool('NonIntrusiveNotificationsEnabled', False)"],
                    env=env, check=True, capture_output=True, timeout=120)
     out = home / "facts.json"
     env["FEMBSPTET_GUI_OUT"] = str(out)
@@ -59,7 +64,11 @@ def test_session_ran_every_step(facts):
 
 def test_command_in_fem_toolbar_menu_and_own_workbench(facts):
     assert facts["workbench_registered"] and facts["command_registered"]
-    assert facts["bsptet_toolbar_in_fem"] == ["FEM_MeshBspTetFromShape"]
+    if facts["workbench_manipulators"]:  # FreeCAD 1.x: among FEM's meshers, just before Gmsh
+        tools = facts["fem_toolbar_with_gmsh"]
+        assert tools.index("FEM_MeshBspTetFromShape") == tools.index("FEM_MeshGmshFromShape") - 1
+    else:  # FreeCAD 0.20/0.21: a toolbar of its own in FEM
+        assert facts["bsptet_toolbar_in_fem"] == ["FEM_MeshBspTetFromShape"]
     entries = facts["fem_mesh_menu_entries"]
     assert "FEM_MeshBspTetFromShape" in entries
     assert entries.index("FEM_MeshBspTetFromShape") == entries.index("FEM_MeshGmshFromShape") + 1
@@ -69,7 +78,9 @@ def test_command_in_fem_toolbar_menu_and_own_workbench(facts):
 
 
 def test_command_creates_object_in_analysis_and_opens_panel(facts):
-    assert facts["object_type"] == "Fem::FemMeshObjectPython"
+    # FreeCAD 1.x: a shape-based FEM mesh object (link Shape); 0.20/0.21: a FEM mesh object
+    assert facts["object_type"] in ("Fem::FemMeshShapeBaseObjectPython", "Fem::FemMeshObjectPython")
+    assert facts["object_type"] == facts["expected_object_type"]
     assert facts["proxy_type"] == "Fem::FemMeshBspTet"
     assert facts["part_link"] == "Block"
     assert facts["view_provider"] == "VPMeshBspTet"

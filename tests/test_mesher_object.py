@@ -21,6 +21,7 @@ if not freecad_available():
 import FemBspTet  # noqa: E402
 from FemBspTet.kernel import core  # noqa: E402
 from FemBspTet.fem import mesh_pipeline as mp  # noqa: E402
+from FemBspTet.freecad.mesher_object import MeshBspTet, set_source, source_of  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
 
@@ -73,10 +74,15 @@ def test_make_mesher_creates_an_unmeshed_fem_mesh_object(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     obj = FemBspTet.make_mesher(doc, part, CharacteristicLengthMax=4, ElementOrder="1st",
                                 CompareWithTetGen=False)
-    assert obj.TypeId == "Fem::FemMeshObjectPython"
+    if "Fem::FemMeshShapeBaseObjectPython" in doc.supportedTypes():  # FreeCAD 1.x
+        assert obj.TypeId == "Fem::FemMeshShapeBaseObjectPython"
+        assert obj.Shape is part and "Part" not in obj.PropertiesList
+    else:  # FreeCAD 0.20/0.21
+        assert obj.TypeId == "Fem::FemMeshObjectPython"
+        assert obj.Part is part
+    assert source_of(obj) is part
     assert obj.isDerivedFrom("Fem::FemMeshObject")
     assert obj.Proxy.Type == "Fem::FemMeshBspTet"
-    assert obj.Part is part
     assert obj.CharacteristicLengthMax.Value == 4 and obj.ElementOrder == "1st"
     assert obj.ElementOrder in obj.getEnumerationsOfProperty("ElementOrder")
     assert obj.getEnumerationsOfProperty("ElementOrder") == ["1st", "2nd"]
@@ -261,13 +267,13 @@ def test_failure_keeps_the_previous_mesh(doc, fc):
     FemBspTet.run_mesher(obj)
     before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.Nodes)
     shell = add_part(doc, fc, Part.Shell(Part.makeBox(1, 1, 1).Faces[:5]), "OpenShell")
-    obj.Part = shell
+    set_source(obj, shell)
     with pytest.raises(InputError, match=r"holds no solid \(1 shell\(s\), 5 face\(s\)\)"):
         FemBspTet.run_mesher(obj)
     assert (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.Nodes) == before
     assert obj.MeshStatus.startswith("failed: ") and "holds no solid" in obj.MeshStatus
-    obj.Part = None
-    with pytest.raises(InputError, match="no Part is set"):
+    set_source(obj, None)
+    with pytest.raises(InputError, match="no solid is set"):
         FemBspTet.run_mesher(obj)
     assert obj.FemMesh.NodeCount == before[0]
 
@@ -412,7 +418,7 @@ def test_save_and_reload(doc, fc, tmp_path):
     d2 = freecad.openDocument(path)
     try:
         o2 = d2.getObject(name)
-        assert o2.Proxy.Type == "Fem::FemMeshBspTet" and o2.Part.Name == part_name
+        assert o2.Proxy.Type == "Fem::FemMeshBspTet" and source_of(o2).Name == part_name
         assert o2.CharacteristicLengthMax.Value == 7.5 and o2.FaceGroups is True
         f2 = o2.FemMesh
         assert {i: tuple(v) for i, v in f2.Nodes.items()} == nodes
@@ -429,6 +435,35 @@ def test_save_and_reload(doc, fc, tmp_path):
         o2.removeProperty("CompareWithTetGen")
         o2.Proxy.onDocumentRestored(o2)
         assert o2.CompareWithTetGen is True
+    finally:
+        freecad.closeDocument(d2.Name)
+
+
+def test_object_of_0_20_files_opens_and_meshes(doc, fc, tmp_path):
+    """A mesher object as FreeCAD 0.20/0.21 make it (Fem::FemMeshObjectPython with our Part link)
+    opens and meshes; on FreeCAD 1.x its Part link becomes a global Shape link on restore."""
+    freecad = fc[0]
+    part = add_part(doc, fc, block_with_hole(fc))
+    obj = doc.addObject("Fem::FemMeshObjectPython", "MeshBspTet")
+    MeshBspTet(obj)
+    obj.Part = part
+    obj.ElementOrder, obj.CompareWithTetGen = "1st", False
+    name, part_name = obj.Name, part.Name
+    path = str(tmp_path / "old_mesher.FCStd")
+    doc.saveAs(path)
+    freecad.closeDocument(doc.Name)
+    d2 = freecad.openDocument(path)
+    try:
+        o2 = d2.getObject(name)
+        assert o2.TypeId == "Fem::FemMeshObjectPython"
+        assert source_of(o2).Name == part_name
+        if "Fem::FemMeshShapeBaseObjectPython" in d2.supportedTypes():  # FreeCAD 1.x
+            assert "Part" not in o2.PropertiesList
+            assert o2.getTypeIdOfProperty("Shape") == "App::PropertyLinkGlobal"
+        else:
+            assert "Shape" not in o2.PropertiesList and o2.Part.Name == part_name
+        FemBspTet.run_mesher(o2)
+        assert o2.FemMesh.VolumeCount > 0
     finally:
         freecad.closeDocument(d2.Name)
 

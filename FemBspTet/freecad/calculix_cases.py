@@ -23,7 +23,7 @@ import os
 
 from ..kernel.errors import InternalError
 from ..kernel.paths import RESOURCES_DIR
-from .mesher_object import make_mesher
+from .mesher_object import make_mesher, set_source
 from .mesher_tools import run_mesher
 
 #: The sample part of the ``bracket`` case.
@@ -75,7 +75,10 @@ def build_case(doc, name):
     doc.recompute()
 
     analysis = ObjectsFem.makeAnalysis(doc, "Analysis")
-    solver = ObjectsFem.makeSolverCalculixCcxTools(doc, "CalculiXccxTools")
+    # FEM's ccxtools solver: makeSolverCalculiXCcxTools on FreeCAD 1.x, the old spelling on 0.20
+    make_solver = getattr(ObjectsFem, "makeSolverCalculiXCcxTools", None) or \
+        ObjectsFem.makeSolverCalculixCcxTools
+    solver = make_solver(doc, "CalculiXccxTools")
     solver.AnalysisType = "static"
     solver.GeometricalNonlinearity = "linear"
     analysis.addObject(solver)
@@ -93,7 +96,7 @@ def build_case(doc, name):
     if name == "cantilever":
         force = ObjectsFem.makeConstraintForce(doc, "Force")
         force.References = [(part, "Face2")]
-        force.Force = 9.0e6
+        set_load(force, "Force", 9.0e6, "N")
         force.Direction = (part, ["Edge5"])
         force.Reversed = True
         analysis.addObject(force)
@@ -102,9 +105,21 @@ def build_case(doc, name):
         loaded = CASES[name].get("pressed") or hole_face_name(part.Shape)
         pressure = ObjectsFem.makeConstraintPressure(doc, "Pressure")
         pressure.References = [(part, loaded)]
-        pressure.Pressure = CASES[name]["pressure_mpa"]
+        set_load(pressure, "Pressure", CASES[name]["pressure_mpa"], "MPa")
         analysis.addObject(pressure)
     return Case(name, doc, part, analysis, solver, loaded)
+
+
+def set_load(constraint, name, value, unit):
+    """Set the load property ``name`` of a FEM constraint to ``value`` in ``unit`` (N or MPa):
+    FreeCAD 0.20 stores a plain number in those units; FreeCAD 1.x stores a quantity (a plain
+    number there would be read in mN or kPa)."""
+    import FreeCAD
+
+    if constraint.getTypeIdOfProperty(name) == "App::PropertyFloat":
+        setattr(constraint, name, float(value))
+    else:
+        setattr(constraint, name, FreeCAD.Units.Quantity("%r %s" % (float(value), unit)))
 
 
 def hole_face_name(shape):
@@ -134,7 +149,7 @@ def add_gmsh_mesh(case, max_size, order):
     from femmesh.gmshtools import GmshTools
 
     obj = ObjectsFem.makeMeshGmsh(case.doc, "MeshGmsh")
-    obj.Part = case.part
+    set_source(obj, case.part)  # Gmsh's link: Shape on FreeCAD 1.x, Part on 0.20/0.21
     obj.CharacteristicLengthMax = max_size
     obj.ElementOrder = "2nd" if order == 2 else "1st"
     case.doc.recompute()

@@ -1,15 +1,20 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The BspTet mesher document object: ``Fem::FemMeshObjectPython`` with proxy type
-``Fem::FemMeshBspTet``, made the way FreeCAD 0.20.2 makes its Gmsh and Netgen mesh objects.
+"""The BspTet mesher document object, made the way the FreeCAD version at hand makes its Gmsh and
+Netgen mesh objects, with proxy type ``Fem::FemMeshBspTet``.
 
     obj = make_mesher(doc, part, CharacteristicLengthMax=500, ElementOrder="2nd")
     FemBspTet.run_mesher(obj)            # meshes it (mesher_tools); recompute never meshes
 
-* C++ type ``Fem::FemMeshObjectPython`` (the type FEM's Gmsh object has in 0.20/0.21; 1.x still
-  has it), so CalculiX, Z88 and Mystran take the object as the analysis mesh. The proxy's
-  ``Type`` is ``Fem::FemMeshBspTet``: FEM never mistakes it for Gmsh.
-* ``Part`` (App::PropertyLink): the solid the mesh is made from. FEM's writers read
-  ``mesh_obj.Part`` when there is no ``Shape``.
+* C++ type: ``Fem::FemMeshShapeBaseObjectPython`` on FreeCAD 1.x, whose built-in ``Shape`` link
+  (global scope) names the solid the mesh is made from; ``Fem::FemMeshObjectPython`` on FreeCAD
+  0.20/0.21 (which have no shape-based mesh type), with our own ``Part`` link. Either way
+  CalculiX, Z88 and Mystran take the object as the analysis mesh, and FEM's writers find the
+  solid (they read ``mesh_obj.Shape``, else ``mesh_obj.Part``). :func:`source_of` and
+  :func:`set_source` read and set the link whatever its name. The proxy's ``Type`` is
+  ``Fem::FemMeshBspTet``: FEM never mistakes it for Gmsh.
+* Files made with 0.20/0.21 (``Fem::FemMeshObjectPython`` with ``Part``) open on 1.x: on restore
+  their ``Part`` link becomes a ``Shape`` link (global scope), as FreeCAD 1.x's own Gmsh object
+  migrates its older files. Such a file still opens on 0.20/0.21, which read either link.
 * Parameters mean what FemMeshGmsh's mean where the names are the same
   (``CharacteristicLengthMax``/``Min``: 0 = automatic; ``ElementOrder`` "1st"/"2nd").
 * Results (read-only in the property editor) are set by ``mesher_tools.apply_result``.
@@ -30,15 +35,20 @@ from .preferences import object_defaults
 
 #: Proxy type (``femutils.type_of_obj``).
 PROXY_TYPE = "Fem::FemMeshBspTet"
-#: C++ type of the document object.
+#: C++ type of the document object on FreeCAD 1.x: a FEM mesh with a built-in ``Shape`` link.
+SHAPE_OBJECT_TYPE = "Fem::FemMeshShapeBaseObjectPython"
+#: C++ type of the document object on FreeCAD 0.20/0.21 (no shape-based type), with ``Part``.
 OBJECT_TYPE = "Fem::FemMeshObjectPython"
+#: The link to the solid: FreeCAD 1.x's built-in one, and ours on 0.20/0.21.
+SHAPE_LINK = "Shape"
+PART_LINK = "Part"
 
 PARAMS_GROUP = "BspTet Mesh Params"
 RESULTS_GROUP = "BspTet Mesh Results"
 
 #: (type, name, group, tooltip, default) of every parameter property.
 PARAMETER_PROPERTIES = (
-    ("App::PropertyLink", "Part", "FEM Mesh", "The solid (Part) the mesh is made from", None),
+    ("App::PropertyLink", PART_LINK, "FEM Mesh", "The solid (Part) the mesh is made from", None),
     ("App::PropertyLength", "CharacteristicLengthMax", PARAMS_GROUP,
      "Largest element size (0 = automatic: the bounding-box diagonal / 20). Curved faces and "
      "edges get smaller elements (12 per full circle)", 0.0),
@@ -99,6 +109,46 @@ ROW_PROPERTIES = {
 }
 
 
+def object_type(doc):
+    """The C++ type of a new mesher object in ``doc``'s FreeCAD (``Fem`` imported)."""
+    return SHAPE_OBJECT_TYPE if SHAPE_OBJECT_TYPE in doc.supportedTypes() else OBJECT_TYPE
+
+
+def source_property(obj):
+    """Name of the link to the solid to mesh: ``Shape`` on FreeCAD 1.x objects (and on 0.20/0.21
+    objects a 1.x version saved), else ``Part``."""
+    if SHAPE_LINK in obj.PropertiesList and \
+            obj.getTypeIdOfProperty(SHAPE_LINK).startswith("App::PropertyLink"):
+        return SHAPE_LINK
+    return PART_LINK
+
+
+def source_of(obj):
+    """The document object with the solid the mesher object meshes, or None."""
+    return getattr(obj, source_property(obj), None)
+
+
+def set_source(obj, part):
+    """Link the mesher object to the document object ``part`` (or None) holding the solid."""
+    setattr(obj, source_property(obj), part)
+
+
+def _migrate_part_to_shape(obj):
+    """On FreeCAD 1.x objects of 0.20/0.21 files: the ``Part`` link becomes a ``Shape`` link of
+    global scope (what FreeCAD 1.x's mesh objects have). Returns True if it did."""
+    if SHAPE_OBJECT_TYPE not in obj.Document.supportedTypes():
+        return False  # FreeCAD 0.20/0.21: Part is the link
+    if PART_LINK not in obj.PropertiesList or SHAPE_LINK in obj.PropertiesList:
+        return False
+    part = obj.getPropertyByName(PART_LINK)
+    obj.setPropertyStatus(PART_LINK, "-LockDynamic")
+    obj.removeProperty(PART_LINK)
+    obj.addProperty("App::PropertyLinkGlobal", SHAPE_LINK, "FEM Mesh",
+                    "The solid (Part) the mesh is made from")
+    obj.Shape = part
+    return True
+
+
 def add_properties(obj):
     """Add every missing property of the mesher object, and remove the parameters of the
     former tessellation pipeline (``mesh_pipeline.REMOVED_PARAMETERS``) from objects of older
@@ -110,7 +160,7 @@ def add_properties(obj):
         obj.removeProperty(name)
     existing = set(obj.PropertiesList)
     for kind, name, group, tip, default in PARAMETER_PROPERTIES:
-        if name in existing:
+        if name in existing or (name == PART_LINK and source_property(obj) == SHAPE_LINK):
             continue
         obj.addProperty(kind, name, group, tip)
         if kind == "App::PropertyEnumeration":
@@ -152,11 +202,14 @@ class MeshBspTet(StatelessProxy):
         add_properties(obj)
 
     def onDocumentRestored(self, obj):
+        import FreeCAD
+
+        if _migrate_part_to_shape(obj):
+            FreeCAD.Console.PrintMessage(
+                "FemBspTet: %s: the Part link of an older file is now the Shape link\n"
+                % obj.Label)
         removed = add_properties(obj)
         if removed:
-            import FreeCAD
-
-
             FreeCAD.Console.PrintMessage(
                 "FemBspTet: %s: removed the former mesher properties %s (%s)\n"
                 % (obj.Label, ", ".join(removed), REMOVED_BECAUSE.split(";")[0]))
@@ -196,12 +249,14 @@ def make_mesher(doc, part=None, name="MeshBspTet", **properties):
         raise InputError("unknown mesher propert%s %s; the parameters are %s"
                          % ("y" if len(unknown) == 1 else "ies", ", ".join(sorted(unknown)),
                             ", ".join(sorted(known - {"Part"}))))
-    obj = doc.addObject(OBJECT_TYPE, name)
+    obj = doc.addObject(object_type(doc), name)
     MeshBspTet(obj)
     values = dict(object_defaults())
     values.update(properties)
     if part is not None:
-        values["Part"] = part
+        values[PART_LINK] = part
+    if PART_LINK in values:  # the solid's link is Shape on FreeCAD 1.x
+        values[source_property(obj)] = values.pop(PART_LINK)
     try:
         for key, value in values.items():
             setattr(obj, key, value)

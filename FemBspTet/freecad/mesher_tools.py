@@ -18,7 +18,7 @@ from ..fem.mesh_pipeline import (FACE_GROUP_PREFIX, mesh_cad_shape, MeshParamete
                                  removed_parameter_message, REMOVED_PARAMETERS)
 from ..kernel.errors import InputError
 from .femmesh import tetmesh_to_femmesh, write_femmesh
-from .mesher_object import RESULT_PROPERTIES, ROW_PROPERTIES
+from .mesher_object import RESULT_PROPERTIES, ROW_PROPERTIES, source_of, source_property
 
 #: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
 EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
@@ -36,11 +36,12 @@ def parameters_from_object(obj):
 
 
 def shape_of(obj):
-    """The shape to mesh: ``obj.Part.Shape``. InputError if there is none."""
-    part = getattr(obj, "Part", None)
+    """The shape to mesh: the ``Shape`` of the object ``obj`` links to (property ``Shape`` on
+    FreeCAD 1.x, ``Part`` on 0.20/0.21). InputError if there is none."""
+    part = source_of(obj)
     if part is None:
-        raise InputError("no Part is set: select the solid to mesh (property Part)",
-                         where=obj.Label)
+        raise InputError("no solid is set: select the solid to mesh (property %s)"
+                         % source_property(obj), where=obj.Label)
     shape = getattr(part, "Shape", None)
     if shape is None or shape.isNull():
         raise InputError("%s has no shape to mesh" % part.Label, where=obj.Label)

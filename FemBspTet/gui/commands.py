@@ -5,8 +5,9 @@
   (journaled: the macro recorder records ``FemBspTet.make_mesher(...)``), adds it to the active
   analysis if there is one, and opens its task panel. Importing this module registers it.
 * FEM's toolbar and menu (:func:`install_in_fem_workbench`):
-  - FreeCAD 1.x: a workbench manipulator puts the command right after FEM's Gmsh command in
-    FEM's Mesh toolbar and Mesh menu.
+  - FreeCAD 1.x: a workbench manipulator puts the command among FEM's meshers: just before
+    FEM's Gmsh command in FEM's Mesh toolbar (a manipulator inserts tool items before another),
+    right after it in FEM's Mesh menu.
   - FreeCAD 0.20/0.21 (no manipulators; FEM is a C++ workbench): a custom toolbar "BspTet"
     defined by parameters, which FEM shows on activation (its workbench reads
     the toolbars stored under its parameter group), and an entry appended to FEM's "Mesh" menu each time FEM is activated.
@@ -17,7 +18,7 @@ import os
 from .view_provider import ICON_PATH
 
 COMMAND_NAME = "FEM_MeshBspTetFromShape"
-#: FEM's Gmsh command: our command goes right after it in FEM's toolbar and menu (1.x).
+#: FEM's Gmsh command: our command goes beside it in FEM's toolbar and menu (1.x).
 GMSH_COMMAND = "FEM_MeshGmshFromShape"
 #: Parameter group of the custom toolbar FEM shows on 0.20/0.21.
 FEM_TOOLBAR_PARAM = "User parameter:BaseApp/Workbench/FemWorkbench/Toolbar/FemBspTet"
@@ -80,8 +81,9 @@ def register():
 
 
 class FemMeshManipulator:
-    """FreeCAD 1.x workbench manipulator: our command after Gmsh's in FEM's toolbar and menu.
-    Gmsh's command exists only in FEM, so nothing else changes."""
+    """FreeCAD 1.x workbench manipulator: our command before Gmsh's in FEM's Mesh toolbar (tool
+    items go before the one named) and after it in FEM's Mesh menu. Gmsh's command exists only
+    in FEM, so nothing else changes."""
 
     def modifyToolBars(self):
         return [{"insert": COMMAND_NAME, "toolItem": GMSH_COMMAND}]

@@ -50,6 +50,12 @@ class VPMeshBspTet(StatelessProxy):
 
         if FreeCADGui.Control.activeDialog():
             FreeCADGui.Control.closeDialog()
+        # as FEM's own meshers: while editing, this mesh shows and the other meshes and results hide
+        for other in vobj.Object.Document.Objects:
+            if other is not vobj.Object and other.ViewObject is not None and (
+                    other.isDerivedFrom("Fem::FemMeshObject")
+                    or other.isDerivedFrom("Fem::FemPostObject")):
+                other.ViewObject.hide()
         vobj.show()
         self.task_panel = TaskPanelMeshBspTet(vobj.Object)  # for scripts and tests; not saved
         FreeCADGui.Control.showDialog(self.task_panel)
