@@ -20,12 +20,9 @@ exact check of the whole mesh reports those faces as crossing: check such a mesh
 
 import numpy as np
 
-from ..kernel.core import native, boundary_surface, certify_tet10, check_mesh
+from ..io.volume_io import triangle_midnodes, triangle_tags_in_file
+from ..kernel.core import boundary_surface, certify_tet10, check_mesh, native
 from ..kernel.mesh_types import TetMesh
-
-#: boundary triangle edges (a, b), (b, c), (c, a) -> our tet10 mid-node columns by corner pair
-_EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
-
 
 def _boundary_nodes(mesh, triangles):
     """Corner nodes of ``triangles`` and, for tet10, the mid-nodes of their edges; with, per
@@ -33,40 +30,9 @@ def _boundary_nodes(mesh, triangles):
     nodes = [triangles.ravel()]
     rows = [np.repeat(np.arange(len(triangles)), 3)]
     if mesh.tets.shape[1] == 10:
-        n = np.int64(len(mesh.points))
-        keys, mids = [], []
-        for k, (a, b) in enumerate(_EDGES):
-            ta, tb = mesh.tets[:, a], mesh.tets[:, b]
-            keys.append(np.minimum(ta, tb) * n + np.maximum(ta, tb))
-            mids.append(mesh.tets[:, 4 + k])
-        keys, mids = np.concatenate(keys), np.concatenate(mids)
-        order = np.argsort(keys, kind="stable")
-        keys, mids = keys[order], mids[order]
-        for a, b in ((0, 1), (1, 2), (2, 0)):
-            ta, tb = triangles[:, a], triangles[:, b]
-            pos = np.searchsorted(keys, np.minimum(ta, tb) * n + np.maximum(ta, tb))
-            nodes.append(mids[pos])
-            rows.append(np.arange(len(triangles)))
+        nodes.append(triangle_midnodes(mesh.tets, len(mesh.points), triangles).T.ravel())
+        rows.append(np.tile(np.arange(len(triangles)), 3))
     return np.concatenate(nodes), np.concatenate(rows)
-
-
-def _triangle_tags(mesh, triangles):
-    """The CAD face (0-based) of each boundary triangle from the file's tagged triangles, -1 where
-    the file has none."""
-    tags = np.full(len(triangles), -1, dtype=np.int64)
-    tagged = mesh.extra.get("triangles")
-    if tagged is None or mesh.extra.get("triangle_tags") is None or not len(tagged):
-        return tags
-    def keys(rows):
-        rows = np.ascontiguousarray(np.sort(np.asarray(rows)[:, :3], axis=1).astype(np.int64))
-        return rows.view(np.dtype((np.void, 24))).ravel()
-    file_keys = keys(tagged)
-    order = np.argsort(file_keys, kind="stable")
-    ours = keys(triangles)
-    pos = np.clip(np.searchsorted(file_keys[order], ours), 0, len(order) - 1)
-    found = file_keys[order][pos] == ours
-    tags[found] = np.asarray(mesh.extra["triangle_tags"], dtype=np.int64)[order][pos][found]
-    return tags
 
 
 def check_against_cad(cad_path, mesh: TetMesh, max_messages=20):
@@ -92,7 +58,7 @@ def check_against_cad(cad_path, mesh: TetMesh, max_messages=20):
                             f"valid (Jacobian not proved positive), first: tets {bad}")
     triangles = boundary.triangles
     nodes, rows = _boundary_nodes(mesh, triangles)
-    tags = _triangle_tags(mesh, triangles)[rows]
+    tags = triangle_tags_in_file(mesh, triangles)[rows]
     # one measurement per node: its file's face if the file names one (the smallest tag seen)
     order = np.lexsort((np.where(tags < 0, np.iinfo(np.int64).max, tags), nodes))
     nodes, tags = nodes[order], tags[order]

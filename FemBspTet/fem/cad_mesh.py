@@ -20,7 +20,7 @@ import numpy as np
 
 from ..kernel.core import core_errors, native, boundary_surface, check_mesh
 from ..kernel.errors import InputError, InternalError
-from ..kernel.mesh_types import MeshGroups, Surface, TetMesh
+from ..kernel.mesh_types import MeshGroups, Surface, TetMesh, triangle_keys
 
 
 @dataclasses.dataclass
@@ -36,20 +36,14 @@ class CadMeshResult:
     groups: MeshGroups = None
 
 
-def _row_keys(triples):
-    """One hashable value per row of sorted corner triples (a void view), for np.unique / isin."""
-    rows = np.ascontiguousarray(np.sort(triples, axis=1).astype(np.int64))
-    return rows.view(np.dtype((np.void, rows.dtype.itemsize * 3))).ravel()
-
-
 def _boundary_rows(tets, triangles):
     """Rows of ``triangles`` (corner columns) that are faces of exactly one tet: the mesh's
     boundary (faces shared by two solids are inside it)."""
     corners = tets[:, :4]
     faces = np.concatenate([corners[:, [0, 1, 2]], corners[:, [0, 1, 3]], corners[:, [0, 2, 3]],
                             corners[:, [1, 2, 3]]])
-    keys, counts = np.unique(_row_keys(faces), return_counts=True)
-    return np.isin(_row_keys(triangles[:, :3]), keys[counts == 1])
+    keys, counts = np.unique(triangle_keys(faces), return_counts=True)
+    return np.isin(triangle_keys(triangles[:, :3]), keys[counts == 1])
 
 
 def _check_each_solid(points, corner_tets, tet_solid, cad_triangles, source):
@@ -57,10 +51,10 @@ def _check_each_solid(points, corner_tets, tet_solid, cad_triangles, source):
     and those faces equal to CAD triangles (``cad_triangles``, merged ids), every CAD triangle a
     face of a tet; InternalError naming the solid if one fails."""
 
-    cad_keys = _row_keys(cad_triangles)
+    cad_keys = triangle_keys(cad_triangles)
     tet_faces = np.concatenate([corner_tets[:, [0, 1, 2]], corner_tets[:, [0, 1, 3]],
                                 corner_tets[:, [0, 2, 3]], corner_tets[:, [1, 2, 3]]])
-    unused = ~np.isin(cad_keys, _row_keys(tet_faces))
+    unused = ~np.isin(cad_keys, triangle_keys(tet_faces))
     if unused.any():
         raise InternalError(f"{source}: {int(unused.sum())} CAD surface triangles are faces of no "
                             "tet of the FEM mesh; this is a bug, please report it")
@@ -70,7 +64,7 @@ def _check_each_solid(points, corner_tets, tet_solid, cad_triangles, source):
         pts = points[used]
         piece = TetMesh(points=pts, tets=local.reshape(tets.shape).astype(np.int64), source=source)
         boundary = boundary_surface(piece)
-        off_cad = ~np.isin(_row_keys(used[boundary.triangles]), cad_keys)
+        off_cad = ~np.isin(triangle_keys(used[boundary.triangles]), cad_keys)
         if off_cad.any():
             raise InternalError(f"{source}: Solid{solid}: {int(off_cad.sum())} boundary faces of the "
                                 "FEM mesh are not triangles of the CAD surface; this is a bug, "

@@ -30,13 +30,21 @@ import numpy as np
 from .atomic_file import atomic_output
 from ..kernel.core import native
 from ..kernel.errors import InputError
-from ..kernel.mesh_types import Surface, TetMesh
+from .volume_io import triangle_tags_in_file
+from ..kernel.mesh_types import Surface, TetMesh, triangle_keys
 
 #: corners of the four faces of a tet, outward for a positively oriented tet
 _FACES = ((1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1))
 #: the two faces at each edge (a, b) of a tet (for the dihedral angle there)
 _EDGE_FACES = ((2, 3), (0, 3), (1, 3), (1, 2), (0, 2), (0, 1))
 VIEW = np.array([1.0, -1.0, 0.8])
+#: the light comes from the viewer's upper left
+LIGHT = np.array([-0.4, -0.6, 1.0]) / np.linalg.norm([-0.4, -0.6, 1.0])
+
+
+def _shade(unit_normals):
+    """Brightness factor of faces with these unit normals (two-sided: 0.45 to 1)."""
+    return 0.45 + 0.55 * np.clip(np.abs(unit_normals @ LIGHT), 0, 1)
 
 
 def worst_dihedral(points, tets):
@@ -58,37 +66,15 @@ def _faces_of(tets):
     corners = tets[:, :4]
     faces = np.concatenate([corners[:, list(f)] for f in _FACES])
     owner = np.tile(np.arange(len(tets)), 4)
-    key = np.ascontiguousarray(np.sort(faces, axis=1)).view(np.dtype((np.void, 24))).ravel()
+    key = triangle_keys(faces)
     _, first, counts = np.unique(key, return_index=True, return_counts=True)
     keep = first[counts == 1]
     return faces[keep], owner[keep]
 
 
-def _tags_of(mesh, faces):
-    tagged = mesh.extra.get("triangles")
-    tags = mesh.extra.get("triangle_tags")
-    if tagged is None or tags is None or not len(tagged):
-        return None
-    def keys(rows):
-        rows = np.ascontiguousarray(np.sort(np.asarray(rows)[:, :3], axis=1).astype(np.int64))
-        return rows.view(np.dtype((np.void, 24))).ravel()
-    file_keys = keys(tagged)
-    order = np.argsort(file_keys, kind="stable")
-    ours = keys(faces)
-    pos = np.clip(np.searchsorted(file_keys[order], ours), 0, len(order) - 1)
-    found = file_keys[order][pos] == ours
-    out = np.full(len(faces), -1, dtype=np.int64)
-    out[found] = np.asarray(tags)[order][pos][found]
-    return out
-
-
 def render_mesh(mesh: TetMesh, path, cut=False, size_px=900, title=None):
     """Writes the picture of ``mesh`` (module doc) to ``path`` (PNG, written whole or not at
     all). Returns a dict of what was drawn: ``triangles``, ``tets`` (drawn), ``cut``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib import cm, colors
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
@@ -106,16 +92,13 @@ def render_mesh(mesh: TetMesh, path, cut=False, size_px=900, title=None):
     tri = points[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-    light = np.array([-0.4, -0.6, 1.0])
-    light /= np.linalg.norm(light)
-    view = VIEW / np.linalg.norm(VIEW)
-    shade = 0.45 + 0.55 * np.clip(np.abs(normal @ light), 0, 1)
+    shade = _shade(normal)
     if cut:
         angle = worst_dihedral(points, tets[kept][owner])
         base = cm.RdYlGn(colors.Normalize(10.0, 40.0)(np.clip(angle, 10.0, 40.0)))
     else:
-        tags = _tags_of(mesh, faces)
-        if tags is not None:
+        tags = triangle_tags_in_file(mesh, faces)
+        if (tags >= 0).any():
             palette = cm.tab20(np.arange(20) % 20)
             base = np.where((tags >= 0)[:, None], palette[np.maximum(tags, 0) % 20],
                             np.array([0.75, 0.8, 0.9, 1.0]))
@@ -125,20 +108,10 @@ def render_mesh(mesh: TetMesh, path, cut=False, size_px=900, title=None):
     rgba[:, :3] *= shade[:, None]
     # back faces (pointing away from the viewer) are hidden by the front ones of a closed
     # boundary: dropping them halves the sorting work and avoids mis-ordered fringes
-    front = (normal @ view) > 0 if not cut else np.ones(len(faces), dtype=bool)
-    inch = size_px / 100.0
-    fig = plt.figure(figsize=(inch, inch), dpi=100)
-    ax = fig.add_subplot(111, projection="3d")
-    collection = Poly3DCollection(tri[front], facecolors=rgba[front],
-                                  edgecolors=(0.1, 0.1, 0.1, 0.35), linewidths=0.15)
-    ax.add_collection3d(collection)
-    radius = 0.75 * float(np.max(hi - lo)) / 2 or 1.0  # the box's isometric view leaves margins
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
-        setter(c - radius, c + radius)
-    ax.set_box_aspect((1, 1, 1))
-    ax.view_init(elev=math.degrees(math.atan2(VIEW[2], math.hypot(VIEW[0], VIEW[1]))),
-                 azim=math.degrees(math.atan2(VIEW[1], VIEW[0])))
-    ax.set_axis_off()
+    front = (normal @ VIEW) > 0 if not cut else np.ones(len(faces), dtype=bool)
+    plt, fig, ax = _axes3d(size_px, lo, hi)
+    ax.add_collection3d(Poly3DCollection(tri[front], facecolors=rgba[front],
+                                         edgecolors=(0.1, 0.1, 0.1, 0.35), linewidths=0.15))
     label = title if title is not None else os.path.basename(mesh.source or "")
     kind = "tet10" if tets.shape[1] == 10 else "tet4"
     ax.set_title(f"{label}  {len(tets):,} {kind}" + (
@@ -190,9 +163,6 @@ def render_bsp_cells(surface: Surface, path, explode=0.4, outside=False, size_px
     points = np.asarray(points)
     lo, hi = surface.points.min(axis=0), surface.points.max(axis=0)
     centre = (lo + hi) / 2
-    light = np.array([-0.4, -0.6, 1.0])
-    light /= np.linalg.norm(light)
-    view = VIEW / np.linalg.norm(VIEW)
     polygons, colours = [], []
     for faces, is_inside in zip(cells, inside):
         if not (is_inside or outside):
@@ -204,10 +174,10 @@ def render_bsp_cells(surface: Surface, path, explode=0.4, outside=False, size_px
             poly = points[np.asarray(face)] + shift
             normal = np.cross(poly[1] - poly[0], poly[2] - poly[0])
             length = np.linalg.norm(normal)
-            if length == 0 or normal @ view <= 0:
+            if length == 0 or normal @ VIEW <= 0:
                 continue  # seen from behind: the cell's front faces cover it
             rgba = base.copy()
-            rgba[:3] *= 0.45 + 0.55 * abs(normal @ light) / length
+            rgba[:3] *= _shade(normal / length)
             polygons.append(poly)
             colours.append(rgba)
     drawn = np.concatenate(polygons) if polygons else surface.points

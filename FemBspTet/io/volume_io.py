@@ -79,7 +79,7 @@ import numpy as np
 from .atomic_file import atomic_output, atomic_outputs
 from .formats import VOLUME_EXTENSIONS
 from ..kernel.errors import InputError, InternalError
-from ..kernel.mesh_types import MeshGroups, TetMesh
+from ..kernel.mesh_types import MeshGroups, TetMesh, triangle_keys
 from .surface_io import (
     _GENERATOR,
     _Text,
@@ -273,15 +273,43 @@ class _Sets:
         return np.unique(self.solid)
 
 
-def _tet_edge_table(tets, n):
-    """Sorted keys ``lo * n + hi`` of the tets' edges and the tet10 mid-node of each."""
+def triangle_midnodes(tets, n_points, triangles):
+    """(k, 3) tet10 mid-nodes of the edges (a, b), (b, c), (c, a) of ``triangles`` (corner
+    columns), read off the tets; -1 where an edge is no edge of a tet."""
+    n = np.int64(n_points)
     keys, mids = [], []
     for k, (a, b) in enumerate(_EDGES):
         keys.append(np.minimum(tets[:, a], tets[:, b]) * n + np.maximum(tets[:, a], tets[:, b]))
         mids.append(tets[:, 4 + k])
     keys, mids = np.concatenate(keys), np.concatenate(mids)
     order = np.argsort(keys, kind="stable")
-    return keys[order], mids[order]
+    keys, mids = keys[order], mids[order]
+    out = np.full((len(triangles), 3), -1, dtype=np.int64)
+    if not len(keys):
+        return out
+    for i, (a, b) in enumerate(((0, 1), (1, 2), (2, 0))):
+        key = np.minimum(triangles[:, a], triangles[:, b]) * n + \
+            np.maximum(triangles[:, a], triangles[:, b])
+        pos = np.clip(np.searchsorted(keys, key), 0, len(keys) - 1)
+        found = keys[pos] == key
+        out[found, i] = mids[pos][found]
+    return out
+
+
+def triangle_tags_in_file(mesh, triangles):
+    """The face tag a read file gives each of ``triangles`` (``mesh.extra["triangles"]`` and
+    ``["triangle_tags"]``, matched by their corners), -1 where the file names none."""
+    tags = np.full(len(triangles), -1, dtype=np.int64)
+    tagged, file_tags = mesh.extra.get("triangles"), mesh.extra.get("triangle_tags")
+    if tagged is None or file_tags is None or not len(tagged) or not len(triangles):
+        return tags
+    file_keys = triangle_keys(tagged)
+    order = np.argsort(file_keys, kind="stable")
+    ours = triangle_keys(triangles)
+    pos = np.clip(np.searchsorted(file_keys[order], ours), 0, len(order) - 1)
+    found = file_keys[order][pos] == ours
+    tags[found] = np.asarray(file_tags, dtype=np.int64)[order][pos][found]
+    return tags
 
 
 def _checked_groups(path, groups, points, tets):
@@ -289,20 +317,14 @@ def _checked_groups(path, groups, points, tets):
     if tri.size and (tri.min() < 0 or tri.max() >= len(points)):
         raise InternalError(f"{path}: a face triangle refers to a node outside "
                             f"0..{len(points) - 1}")
-    n = np.int64(len(points))
     if tets.shape[1] == 10 and tri.shape[1] == 3:
-        edge_keys, mids = _tet_edge_table(tets, n)
-        extra = []
-        for a, b in ((0, 1), (1, 2), (2, 0)):
-            key = np.minimum(tri[:, a], tri[:, b]) * n + np.maximum(tri[:, a], tri[:, b])
-            pos = np.clip(np.searchsorted(edge_keys, key), 0, max(len(edge_keys) - 1, 0))
-            bad = edge_keys[pos] != key if len(edge_keys) else np.ones(len(key), dtype=bool)
-            if bad.any():
-                i = int(np.flatnonzero(bad)[0])
-                raise InputError(f"surface triangle {i} has an edge that is not an edge of the "
-                                 f"mesh; cannot write the boundary triangles", where=path)
-            extra.append(mids[pos])
-        tri = np.column_stack([tri] + extra)
+        mids = triangle_midnodes(tets, len(points), tri)
+        bad = (mids < 0).any(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InputError(f"surface triangle {i} has an edge that is not an edge of the "
+                             f"mesh; cannot write the boundary triangles", where=path)
+        tri = np.column_stack([tri, mids])
     elif tets.shape[1] == 4:
         tri = tri[:, :3]
     if groups.tet_solid is None:
@@ -1139,8 +1161,7 @@ def _element_faces(tets, tri):
     CalculiX number 0..3 (``_INP_FACES``); InternalError if a triangle is no tet's face."""
     m = len(tets)
     faces = np.concatenate([tets[:, list(f)] for f in _INP_FACES])
-    rows = np.ascontiguousarray(np.sort(np.concatenate([tri[:, :3], faces]), axis=1))
-    keys = rows.view(np.dtype((np.void, 24))).ravel()
+    keys = triangle_keys(np.concatenate([tri[:, :3], faces]))
     _, inverse = np.unique(keys, return_inverse=True)
     inverse = inverse.ravel()
     first = np.full(inverse.max() + 1 if len(inverse) else 0, -1, dtype=np.int64)

@@ -20,6 +20,13 @@ from typing import List, Optional
 import numpy as np
 
 
+def triangle_keys(rows):
+    """One hashable value per row of corner triples (the first three columns, in any order): a
+    void view of the sorted triple, for np.unique, np.isin and np.searchsorted."""
+    rows = np.ascontiguousarray(np.sort(np.asarray(rows)[:, :3], axis=1).astype(np.int64))
+    return rows.view(np.dtype((np.void, 24))).ravel()
+
+
 @dataclass
 class Surface:
     """A triangle surface.

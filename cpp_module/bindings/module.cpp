@@ -599,14 +599,12 @@ PYBIND11_MODULE(_bsptet, m) {
 
   m.def(
       "cad_face_distances",
-      [](const std::string& path, py::array_t<double, py::array::c_style | py::array::forcecast> points,
+      [](const std::string& path, const DoubleArray& points,
          py::array_t<int, py::array::c_style | py::array::forcecast> faces) {
-        if (points.ndim() != 2 || points.shape(1) != 3)
-          throw InputError(ErrorCode::kBadArgument, "cad_distance", -1, "points must have shape (n, 3)");
-        const auto n = static_cast<std::size_t>(points.shape(0));
+        const std::vector<double> xyz = points_from(points, "points");
+        const std::size_t n = xyz.size() / 3;
         std::vector<Vec3> pts(n);
-        const double* p = points.data();
-        for (std::size_t i = 0; i < n; ++i) pts[i] = Vec3{p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+        for (std::size_t i = 0; i < n; ++i) pts[i] = Vec3{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
         std::vector<int> fs(faces.data(), faces.data() + faces.size());
         cad::FaceDistances d;
         {
@@ -634,12 +632,8 @@ PYBIND11_MODULE(_bsptet, m) {
           v = bsp_cells_view(s);
         }
         py::array_t<double> pts({static_cast<py::ssize_t>(v.points.size()), static_cast<py::ssize_t>(3)});
-        auto out = pts.mutable_unchecked<2>();
-        for (std::size_t i = 0; i < v.points.size(); ++i) {
-          out(static_cast<py::ssize_t>(i), 0) = v.points[i].x;
-          out(static_cast<py::ssize_t>(i), 1) = v.points[i].y;
-          out(static_cast<py::ssize_t>(i), 2) = v.points[i].z;
-        }
+        double* out = pts.mutable_data();
+        for (const Vec3& p : v.points) *out++ = p.x, *out++ = p.y, *out++ = p.z;
         return py::make_tuple(pts, v.cells, v.inside);
       },
       py::arg("points"), py::arg("triangles"),

@@ -254,6 +254,22 @@ static void return_free_memory() {
 #endif
 }
 
+// The implicit geometry of a checked surface: its points and the corners of the box around it
+// (explicit vertices), the input triangles' planes grouped (`tri_plane`: each triangle's plane)
+// and each input vertex noted on its triangles' planes. What the BSP is built on.
+static std::unique_ptr<ImplicitGeometry> input_geometry(const SurfaceMesh& surface, std::vector<Index>* tri_plane) {
+  std::vector<Vec3> pts;
+  pts.reserve(surface.num_points() + 8);
+  for (Index i = 0; i < surface.num_points(); ++i) pts.push_back(surface.point(i));
+  for (const Vec3& c : BspComplex::box_corners(surface)) pts.push_back(c);
+  auto geo = std::make_unique<ImplicitGeometry>(std::move(pts));
+  for (Index i = 0; i < geo->num_explicit(); ++i) geo->add_explicit_vertex(i);
+  *tri_plane = group_planes(*geo, surface);
+  for (Index t = 0; t < surface.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) geo->note_on_plane(surface.tri[3 * t + k], (*tri_plane)[t]);
+  return geo;
+}
+
 // `seeded` (may be null) is set as soon as the complex exists: did this attempt use the Delaunay
 // seed (so that tetrahedralize knows what a failure means)? `surface_checked`: check_surface
 // passed on `input` (check_and_tetrahedralize), so validate_surface's weaker checks are skipped.
@@ -280,16 +296,10 @@ static TetMesh tetrahedralize_once(const SurfaceMesh& input, const MeshOptions& 
   stage_time("input_check", t0);
 
   t0 = Clock::now();
-  std::vector<Vec3> pts;
-  pts.reserve(surface.num_points() + 8);
-  for (Index i = 0; i < surface.num_points(); ++i) pts.push_back(surface.point(i));
-  for (const Vec3& c : BspComplex::box_corners(surface)) pts.push_back(c);
-  ImplicitGeometry geo(std::move(pts));
-  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
-  std::vector<Index> tri_plane = group_planes(geo, surface);
+  std::vector<Index> tri_plane;
+  const std::unique_ptr<ImplicitGeometry> geometry = input_geometry(surface, &tri_plane);
+  ImplicitGeometry& geo = *geometry;
   st.input_planes = geo.num_planes();
-  for (Index t = 0; t < surface.num_triangles(); ++t)
-    for (int k = 0; k < 3; ++k) geo.note_on_plane(surface.tri[3 * t + k], tri_plane[t]);
   stage_time("planes", t0);
   check_cancel("planes");
 
@@ -549,15 +559,9 @@ TetMesh check_and_tetrahedralize(const SurfaceMesh& input, const SurfaceCheckOpt
 
 BspCellsView bsp_cells_view(const SurfaceMesh& input) {
   const SurfaceMesh surface = validated_surface(input);
-  std::vector<Vec3> pts;
-  pts.reserve(surface.num_points() + 8);
-  for (Index i = 0; i < surface.num_points(); ++i) pts.push_back(surface.point(i));
-  for (const Vec3& c : BspComplex::box_corners(surface)) pts.push_back(c);
-  ImplicitGeometry geo(std::move(pts));
-  for (Index i = 0; i < geo.num_explicit(); ++i) geo.add_explicit_vertex(i);
-  const std::vector<Index> tri_plane = group_planes(geo, surface);
-  for (Index t = 0; t < surface.num_triangles(); ++t)
-    for (int k = 0; k < 3; ++k) geo.note_on_plane(surface.tri[3 * t + k], tri_plane[t]);
+  std::vector<Index> tri_plane;
+  const std::unique_ptr<ImplicitGeometry> geometry = input_geometry(surface, &tri_plane);
+  ImplicitGeometry& geo = *geometry;
   BspComplex bsp(geo, surface, tri_plane, BspSeed::kBox);
   bsp.build(nullptr, nullptr);
   bsp.identify_input_vertices();
