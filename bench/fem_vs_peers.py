@@ -59,8 +59,6 @@ FREECAD_EXT = "/usr/share/freecad/Ext"
 TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
 # The same tet with corners 1 and 2 swapped (the other orientation), mid-nodes following.
 TET10_FLIP = np.array([0, 2, 1, 3, 6, 5, 4, 7, 9, 8])
-# Netgen's Element3D.points: corners, then mid-nodes of (0,1) (0,2) (0,3) (1,2) (1,3) (2,3).
-NETGEN_TO_VTK_TET10 = np.array([0, 1, 2, 3, 4, 7, 5, 6, 8, 9])
 # Faces of a positively oriented tet (det[v1-v0, v2-v0, v3-v0] > 0), outward, face k opposite
 # corner k.
 TET_FACES = np.array([(1, 2, 3), (0, 3, 2), (0, 1, 3), (0, 2, 1)])
@@ -273,73 +271,17 @@ def worker_gmsh(part, h, order, out):
     write_sidecar(out, {"mesher_seconds": seconds, "settings": settings})
 
 
-# nglib's Ng_Meshing_Parameters (Netgen 6.2.1905): byte offsets of the fields set here, and the
-# defaults its constructor must leave there (checked before anything is written).
-NGLIB_PARAMS = {"uselocalh": (0, "i", 1), "maxh": (8, "d", 1000.0), "grading": (32, "d", 0.3),
-                "elementsperedge": (40, "d", 2.0), "elementspercurve": (48, "d", 2.0),
-                "meshsize_filename": (96, "Q", 0), "optsteps_3d": (112, "i", 3)}
-
-
-def set_netgen_global_size(h):
-    """Netgen 6.2.1905's Python OCC meshing sets its local mesh size (edge division, surface size)
-    from the library's global `netgen::mparam`, not from the MeshingParameters it is given
-    (NGSolve/netgen pull request #25 fixed this later in 2019), so maxh alone changes nothing
-    on a box. Set the global as C++ callers do: nglib's Ng_Meshing_Parameters with maxh = h,
-    segments per edge 1, curvature safety 2, grading 0.3 (MeshingParameters' defaults), then
-    Transfer_Parameters(). Returns what must stay alive while meshing."""
-    import ctypes
-    import struct
-
-    import netgen
-
-    lib_dir = getattr(netgen, "_netgen_lib_dir", "/usr/lib/x86_64-linux-gnu/netgen")
-    lib = ctypes.CDLL(os.path.join(lib_dir, "libnglib.so.6.2"))
-    construct = lib["_ZN5nglib21Ng_Meshing_ParametersC1Ev"]
-    transfer = lib["_ZN5nglib21Ng_Meshing_Parameters19Transfer_ParametersEv"]
-    for f in (construct, transfer):
-        f.argtypes, f.restype = [ctypes.c_void_p], None
-    params = ctypes.create_string_buffer(512)
-    construct(params)
-    for name, (offset, kind, default) in NGLIB_PARAMS.items():
-        if struct.unpack_from("<" + kind, params, offset)[0] != default:
-            raise RuntimeError("nglib's Ng_Meshing_Parameters has another layout (%s)" % name)
-    empty = ctypes.c_char_p(b"")
-    values = {"maxh": h, "elementsperedge": 1.0, "elementspercurve": 2.0, "grading": 0.3,
-              "meshsize_filename": ctypes.cast(empty, ctypes.c_void_p).value}
-    for name, value in values.items():
-        offset, kind, _ = NGLIB_PARAMS[name]
-        struct.pack_into("<" + kind, params, offset, value)
-    transfer(params)
-    return params, empty
-
-
 def worker_netgen(part, h, order, out):
-    """python3-netgen (6.2.1905): OCC geometry, MeshingParameters(maxh=h), SecondOrder()."""
+    """python3-netgen on the part at maxh = h, second order when asked
+    (FemBspTet.peers.netgen.mesh_with_netgen: the same Netgen run as the task panel's)."""
     import meshio
-    from netgen.meshing import MeshingParameters
-    from netgen.NgOCC import LoadOCCGeometry
 
-    t0 = time.perf_counter()
-    global_size = set_netgen_global_size(h)
-    geometry = LoadOCCGeometry(part)
-    mesh = geometry.GenerateMesh(mp=MeshingParameters(maxh=h))
-    del global_size  # kept alive until here
-    if order == 2:
-        mesh.SecondOrder()
-    seconds = time.perf_counter() - t0
-    points = np.array([p.p for p in mesh.Points()], dtype=float)
-    tets = np.array([[v.nr - 1 for v in e.points] for e in mesh.Elements3D()], dtype=np.int64)
-    if len(tets) == 0:
-        sys.exit("netgen: no volume elements")
-    if order == 2:
-        tets = tets[:, NETGEN_TO_VTK_TET10]
+    sys.path.insert(0, ROOT)
+    from FemBspTet.peers.netgen import mesh_with_netgen
+
+    points, tets, seconds, settings = mesh_with_netgen(part, h, order)
     meshio.write(out, meshio.Mesh(points, [("tetra10" if order == 2 else "tetra", tets)]))
-    write_sidecar(out, {"mesher_seconds": seconds,
-                        "settings": {"maxh": h, "second_order": order == 2,
-                                     "other MeshingParameters": "defaults (grading 0.3, "
-                                     "curvaturesafety 2, segmentsperedge 1, optsteps3d 3)",
-                                     "global mparam": "set the same through nglib "
-                                     "(set_netgen_global_size)"}})
+    write_sidecar(out, {"mesher_seconds": seconds, "settings": settings})
 
 
 def run_worker(argv):
@@ -832,7 +774,7 @@ def how_run_section(results, args):
            "global as C++ callers (FreeCAD's and SALOME's Netgen plug-ins) do: nglib's "
            "`Ng_Meshing_Parameters` with maxh = H, elementsperedge 1, elementspercurve 2, "
            "grading 0.3 (the MeshingParameters defaults, FreeCAD's 'Moderate'), then "
-           "`Transfer_Parameters()`, called through ctypes (`set_netgen_global_size`).",
+           "`Transfer_Parameters()`, called through ctypes (`FemBspTet.peers.netgen`).",
            "  Netgen 6.2.1905 reads only STEP and IGES here (a .brep is parsed as STEP and "
            "refused), so BREP parts are exported to STEP by FreeCAD before the timed run.", ""]
     for m, settings in peer_settings(results).items():

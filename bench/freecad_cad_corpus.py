@@ -52,7 +52,7 @@ def main():
             print(" | ".join(str(c) for c in rows[-1]), flush=True)
             continue
         size = args.size_of_diagonal * shape.BoundBox.DiagonalLength
-        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_tetgen=False),
+        job = MeshJob(shape, MeshParameters(max_size=size, order=args.order, compare_peers=False),
                       source=name, python="/usr/bin/python3")
         job.start()
         if not job.wait(args.timeout):

@@ -25,7 +25,7 @@ NICE=(nice -n 19)
 
 PACKAGES=(
   # FreeCAD 1.0 and its FEM peers
-  freecad-python3 gmsh python3-gmsh tetgen
+  freecad-python3 gmsh python3-gmsh tetgen python3-netgen
   # build
   cmake ninja-build g++ pybind11-dev python3-dev libgmp-dev libtbb-dev
   libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev libocct-data-exchange-dev

@@ -32,7 +32,7 @@ def step(name):
 try:
     import FreeCAD
     import FreeCADGui
-    from PySide import QtGui
+    from PySide import QtCore, QtGui
 
     from FemBspTet.freecad.mesher_object import object_type, set_source, source_of
 
@@ -86,6 +86,19 @@ try:
         facts["command_active_with_selection"] = CommandMeshBspTetFromShape().IsActive()
         FreeCADGui.Selection.clearSelection()
         facts["command_active_without_selection"] = CommandMeshBspTetFromShape().IsActive()
+        from FemBspTet.gui import commands
+
+        for _ in range(3):
+            QtGui.QApplication.processEvents()
+        menu = commands.fem_mesh_menu()
+        entry = [a for a in menu.actions() if a.objectName() == commands.COMMAND_NAME]
+        menu.aboutToShow.emit()
+        for _ in range(3):
+            QtGui.QApplication.processEvents()
+        facts["menu_entry_enabled_without_selection"] = entry[0].isEnabled() if entry else None
+        facts["objects_before_command_without_selection"] = len(doc.Objects)
+        FreeCADGui.runCommand(commands.COMMAND_NAME)  # does nothing, says so
+        facts["objects_after_command_without_selection"] = len(doc.Objects)
         FreeCADGui.Selection.addSelection(block)
         FreeCADGui.runCommand("FEM_MeshBspTetFromShape")
         obj = doc.getObject("MeshBspTet")
@@ -130,8 +143,59 @@ try:
         facts["nodes_after_mesh"] = obj.FemMesh.NodeCount
         facts["tets_after_mesh"] = obj.FemMesh.VolumeCount
         facts["result_nodes_property"] = obj.Nodes
-        facts["tetgen_tets_property"] = obj.TetGenTetrahedra
-        facts["tetgen_min_dihedral_property"] = obj.TetGenMinDihedralAngle
+        from FemBspTet.freecad.mesher_tools import comparison_rows
+
+        facts["comparison_rows"] = [r.to_dict() for r in comparison_rows(obj)]
+        facts["median_property"] = obj.MedianTetMinDihedralAngle
+        facts["face_count_after_mesh"] = obj.FemMesh.FaceCount
+        facts["group_count_after_mesh"] = obj.FemMesh.GroupCount
+        facts["cad_faces"] = len(source_of(obj).Shape.Faces)
+        # does the panel fit FreeCAD's combo view as it opens? (the task view is a scroll area)
+        QtGui.QApplication.processEvents()
+        mw = FreeCADGui.getMainWindow()
+        areas = [a for a in mw.findChildren(QtGui.QScrollArea) if a.isAncestorOf(tp.form)]
+        facts["panel_in_scroll_area"] = len(areas) == 1
+        if areas:
+            area = areas[0]
+            view = area.viewport()
+            facts["task_view_width"] = view.width()
+            facts["panel_min_width"] = tp.form.minimumSizeHint().width()
+            facts["panel_width"] = tp.form.width()
+            facts["panel_parts_min_width"] = {
+                w.title(): w.minimumSizeHint().width()
+                for w in tp.form.findChildren(QtGui.QGroupBox)}
+            facts["panel_table_min_width"] = tp.table.minimumSizeHint().width()
+            facts["task_view_content_min_width"] = area.widget().minimumSizeHint().width()
+            facts["task_view_parts_min_width"] = {
+                w.metaObject().className().split("::")[-1]: w.minimumSizeHint().width()
+                for w in area.widget().children() if isinstance(w, QtGui.QWidget)}
+            facts["panel_wide_widgets"] = sorted(
+                (max(w.minimumSizeHint().width(), w.minimumWidth()), w.metaObject().className(),
+                 getattr(w, "text", lambda: "")() if hasattr(w, "text") else "")
+                for w in tp.form.findChildren(QtGui.QWidget)
+                if max(w.minimumSizeHint().width(), w.minimumWidth()) > 120)
+            facts["panel_font"] = [tp.form.font().family(), tp.form.font().pointSizeF(),
+                                   tp.form.fontMetrics().averageCharWidth()]
+            facts["task_view_hscroll"] = area.horizontalScrollBar().maximum()
+            docks = [d for d in mw.findChildren(QtGui.QDockWidget) if d.isAncestorOf(area)]
+            top = docks[0] if docks else area
+            buttons = [b for box in top.findChildren(QtGui.QDialogButtonBox)
+                       for b in box.buttons() if b.isVisible()]
+            facts["dialog_buttons"] = sorted(b.text().replace("&", "") for b in buttons)
+            facts["dialog_buttons_inside"] = all(
+                b.mapTo(top, QtCore.QPoint(b.width(), 0)).x() <= top.width() for b in buttons)
+            table = tp.table
+            facts["table_fits"] = table.mapTo(tp.form, QtCore.QPoint(table.width(), 0)).x() \
+                <= view.width()
+            facts["table_columns_fit"] = table.horizontalHeader().length() <= \
+                table.viewport().width()
+        # the spin box keeps what it was given to the full precision
+        obj.CharacteristicLengthMax = 10.123456789
+        tp.load_parameters()
+        tp.store_parameters()
+        facts["size_after_store"] = obj.CharacteristicLengthMax.Value
+        obj.CharacteristicLengthMax = 10
+        tp.load_parameters()
         facts["mesh_status"] = obj.MeshStatus
         shot = os.environ.get("FEMBSPTET_GUI_SCREENSHOT")
         if shot:
@@ -183,6 +247,12 @@ try:
         obj = state["obj"]
         obj.ViewObject.Proxy.doubleClicked(obj.ViewObject)
         facts["dialog_open_after_double_click"] = bool(FreeCADGui.Control.activeDialog())
+        tp = obj.ViewObject.Proxy.task_panel
+        facts["reopened_progress"] = tp.progress.value()
+        facts["reopened_status"] = tp.status.text()
+        facts["mesh_status_at_reopen"] = obj.MeshStatus
+        facts["reopened_progress_text_visible"] = tp.progress.isTextVisible()
+        facts["reopened_table_rows"] = len([r for r in tp.comparison_table()[1:] if "-" not in r[1:]])
         FreeCADGui.Control.closeDialog()
         FreeCADGui.ActiveDocument.resetEdit()
 

@@ -5,7 +5,7 @@ checkout installed as a Mod in a throw-away HOME (so the user's configuration is
 tests/gui_offscreen_session.py runs inside FreeCAD and records facts; this test asserts them: the
 command in FEM's toolbar and Mesh menu and in our workbench, the command creating the object in
 the active analysis and opening the task panel, the task panel meshing in a worker process with
-stats and the TetGen table, Stop killing the worker and keeping the previous mesh, a failed run
+stats and the comparison at the same size, fitting the combo view, Stop killing the worker and keeping the previous mesh, a failed run
 keeping the previous mesh, save/reload with the mesh, the preferences page.
 About 10-20 s.
 """
@@ -16,6 +16,8 @@ import shutil
 import subprocess
 
 import pytest
+
+from FemBspTet.gui.task_panel import compact_count
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SESSION = os.path.join(ROOT, "tests", "gui_offscreen_session.py")
@@ -75,6 +77,9 @@ def test_command_in_fem_toolbar_menu_and_own_workbench(facts):
     assert facts["own_workbench_toolbar"] == ["FEM_MeshBspTetFromShape"]
     assert facts["command_active_with_selection"] is True
     assert facts["command_active_without_selection"] is False
+    assert facts["menu_entry_enabled_without_selection"] is False
+    assert facts["objects_after_command_without_selection"] == \
+        facts["objects_before_command_without_selection"]
 
 
 def test_command_creates_object_in_analysis_and_opens_panel(facts):
@@ -102,13 +107,51 @@ def test_task_panel_meshes_in_a_worker_and_shows_stats(facts):
     assert facts["mesh_status"] == "meshed: %d nodes, %d tet4" % (n, t)
     assert facts["panel_status"] == facts["mesh_status"]
     assert facts["panel_stats"].startswith("%d nodes, %d tetrahedra" % (n, t))
-    table = {row[0]: row[1:] for row in facts["panel_table"]}
-    # the rows and their labels are the comparison's (compare.comparison.COLUMNS)
-    assert table["nodes"][0] == str(n) and table["tets"][0] == str(t)
-    assert int(table["tets"][1]) == facts["tetgen_tets_property"] > 0
-    assert list(table["valid"]) == ["yes", "yes"]
-    assert float(table["min dih"][1]) == pytest.approx(facts["tetgen_min_dihedral_property"],
-                                                       abs=0.005)
+    # the comparison at the same size: one row per mesher, ours first, the same figures as the
+    # object's properties; TetGen, Gmsh and Netgen are declared dependencies: all there
+    head, *cells = facts["panel_table"]
+    assert tuple(head) == ("", "ours", "TetGen", "Gmsh", "Netgen")
+    table = {row[0]: row[1:] for row in cells}  # figure -> one cell per mesher
+    assert list(table) == ["nodes", "tets", "min°", "med°", "s"]
+    rows = facts["comparison_rows"]
+    assert [r["mesher"] for r in rows] == ["FemBspTet", "TetGen", "Gmsh", "Netgen"]
+    assert (table["nodes"][0], table["tets"][0]) == (str(n), str(t))  # small: written out
+    for k, row in enumerate(rows):
+        assert row["status"] == "ok", row
+        assert row["tets"] > 0 and table["tets"][k] == compact_count(row["tets"])
+        assert float(table["min°"][k]) == pytest.approx(row["min_dihedral_deg"], abs=0.05)
+        assert float(table["med°"][k]) == pytest.approx(row["median_tet_min_dihedral_deg"],
+                                                       abs=0.05)
+    assert rows[1]["command"].startswith("tetgen -pq1.414a")
+    # faces and groups per CAD face by default: a face group and a node group per face
+    assert facts["face_count_after_mesh"] > 0
+    assert facts["group_count_after_mesh"] == 2 * facts["cad_faces"]
+
+
+def test_task_panel_fits_the_combo_view(facts):
+    """FreeCAD's combo view as a new user's FreeCAD opens it (offscreen: a 244-pixel task view at
+    a 12-point font): our panel fits it, every figure of the comparison shown, no column cut.
+    FreeCAD's own OK/Apply/Cancel row at that font may be wider than the view (it is the same
+    for every task panel): the test only asks that our panel never be the part that widens it."""
+    assert facts["panel_in_scroll_area"] is True
+    parts = facts["task_view_parts_min_width"]  # TaskEditControl (the buttons), TaskBox (ours)
+    assert facts["panel_min_width"] <= facts["task_view_width"], facts
+    assert parts["TaskBox"] <= facts["task_view_width"], parts
+    if facts["task_view_hscroll"] > 0:  # only FreeCAD's button row can make it scroll
+        assert parts["TaskEditControl"] > facts["task_view_width"], parts
+    assert set(facts["dialog_buttons"]) >= {"OK", "Apply", "Cancel"}
+    assert facts["table_fits"] is True and facts["table_columns_fit"] is True
+
+
+def test_task_panel_keeps_the_size_exact_and_reopens_with_results(facts):
+    assert facts["size_after_store"] == 10.123456789
+    # reopened after the failed run: its message, the mesh before it, no percentage anywhere
+    assert facts["mesh_status_at_reopen"].startswith("failed: ")
+    assert facts["reopened_status"].startswith(facts["mesh_status_at_reopen"])
+    assert facts["reopened_status"].endswith("The mesh shown is the one before.")
+    assert facts["reopened_progress"] == 0
+    assert facts["reopened_progress_text_visible"] is False
+    assert facts["reopened_table_rows"] == 5  # every figure of every mesher
 
 
 def test_stop_kills_the_worker_and_keeps_the_mesh(facts):
@@ -143,4 +186,4 @@ def test_save_and_reload_with_the_mesh(facts):
 
 def test_preferences_page_loads(facts):
     assert facts["prefs_combobox_class"] == "Gui::PrefComboBox"
-    assert facts["prefs_checkboxes"] == ["ck_compare_tetgen", "ck_face_groups"]
+    assert facts["prefs_checkboxes"] == ["ck_compare_peers", "ck_face_groups"]

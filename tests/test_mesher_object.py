@@ -22,6 +22,7 @@ import FemBspTet  # noqa: E402
 from FemBspTet.kernel import core  # noqa: E402
 from FemBspTet.fem import mesh_pipeline as mp  # noqa: E402
 from FemBspTet.freecad.mesher_object import MeshBspTet, set_source, source_of  # noqa: E402
+from FemBspTet.freecad.mesher_tools import comparison_line, comparison_rows  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
 
@@ -73,7 +74,7 @@ def assert_every_face_node_found(result, fem, shape):
 def test_make_mesher_creates_an_unmeshed_fem_mesh_object(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     obj = FemBspTet.make_mesher(doc, part, CharacteristicLengthMax=4, ElementOrder="1st",
-                                CompareWithTetGen=False)
+                                CompareWithPeers=False)
     if "Fem::FemMeshShapeBaseObjectPython" in doc.supportedTypes():  # FreeCAD 1.x
         assert obj.TypeId == "Fem::FemMeshShapeBaseObjectPython"
         assert obj.Shape is part and "Part" not in obj.PropertiesList
@@ -86,8 +87,13 @@ def test_make_mesher_creates_an_unmeshed_fem_mesh_object(doc, fc):
     assert obj.CharacteristicLengthMax.Value == 4 and obj.ElementOrder == "1st"
     assert obj.ElementOrder in obj.getEnumerationsOfProperty("ElementOrder")
     assert obj.getEnumerationsOfProperty("ElementOrder") == ["1st", "2nd"]
-    for name in ("Nodes", "Tetrahedra", "MinDihedralAngle", "TetGenTetrahedra", "MeshStatus"):
+    for name in ("Nodes", "Tetrahedra", "MinDihedralAngle", "Comparison", "MeshStatus"):
         assert "ReadOnly" in obj.getEditorMode(name)
+    assert "Hidden" in obj.getEditorMode("ComparisonData")
+    # faces and groups per CAD face by default; short group names the property editor shows
+    assert obj.FaceGroups is True and obj.CompareWithPeers is False
+    assert obj.getGroupOfProperty("CharacteristicLengthMax") == "Mesh Params"
+    assert obj.getGroupOfProperty("Nodes") == "Mesh Results"
     doc.recompute()  # recompute never meshes
     assert obj.FemMesh.NodeCount == 0 and obj.Nodes == 0
 
@@ -111,7 +117,7 @@ def test_femutils_sees_our_type_not_gmsh(doc, fc):
 
 def test_run_mesher_tet4_smesh_conventions_and_face_nodes(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=True)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=True)
     result = FemBspTet.run_mesher(obj)
     fem = obj.FemMesh
     assert fem.NodeCount == obj.Nodes == len(result.mesh.points)
@@ -124,32 +130,37 @@ def test_run_mesher_tet4_smesh_conventions_and_face_nodes(doc, fc):
     # the tet volume is the solid's volume (up to the chords of the hole)
     assert abs(-smesh_signed_volumes(fem).sum() / 6 - part.Shape.Volume) < 0.01 * part.Shape.Volume
     assert obj.MeshStatus == "meshed: %d nodes, %d tet4" % (obj.Nodes, obj.Tetrahedra)
-    # TetGen fills OpenCASCADE's display tessellation of the part (the comparison)
-    assert obj.TetGenCommand == "tetgen -pY" and obj.TetGenTetrahedra > 0 and obj.TetGenNodes > 0
-    # the properties are the comparison's tetgen -pY row (compare.comparison.tetgen_pY_row)
-    row = result.tetgen
-    assert row["status"] == "ok" and row["valid"] is True and obj.TetGenValid is True
-    assert (obj.TetGenNodes, obj.TetGenTetrahedra, obj.TetGenSteinerPoints,
-            obj.TetGenBoundarySteinerPoints) == (row["nodes"], row["tets"],
-                                                 row["steiner_points"], 0)
-    assert obj.TetGenMinDihedralAngle == row["min_dihedral_deg"] > 0
-    assert obj.TetGenPeakMemory == row["peak_rss_mb"] > 0
+    # the comparison at the same size: ours, TetGen on our surface, Gmsh and Netgen on the part
+    rows = {r["mesher"]: r for r in result.comparison}
+    assert list(rows) == ["FemBspTet", "TetGen", "Gmsh", "Netgen"]
+    assert all(r["status"] == "ok" for r in rows.values()), rows
+    assert (rows["FemBspTet"]["nodes"], rows["FemBspTet"]["tets"]) == (obj.Nodes, obj.Tetrahedra)
+    assert rows["FemBspTet"]["min_dihedral_deg"] == pytest.approx(obj.MinDihedralAngle)
+    size = result.stats["size"]
+    assert rows["TetGen"]["command"] == "tetgen -pq1.414a%.6g" % (size ** 3 / (6 * 2 ** 0.5))
+    assert rows["Gmsh"]["command"] == "gmsh -3 -clmax %.4g -order 1" % size
+    for name, row in rows.items():
+        # the same part at the same size: counts of one order of magnitude, sane angles
+        assert 0.2 < row["tets"] / obj.Tetrahedra < 5, (name, row, obj.Tetrahedra)
+        assert 0 < row["min_dihedral_deg"] <= row["median_tet_min_dihedral_deg"] < 70.6
+        assert row["seconds"] > 0
+    assert len(obj.Comparison) == 4 and obj.Comparison[1].startswith("TetGen (tetgen -pq")
+    assert comparison_rows(obj)[0].to_dict() == result.comparison[0]
     assert obj.MeshingTime > 0 and obj.MinDihedralAngle > 0 and obj.MaxRadiusEdgeRatio > 0
 
 
-def test_tetgen_properties_of_a_skipped_tetgen_row(doc, fc, monkeypatch, tmp_path):
-    from FemBspTet.compare.comparison import run_tetgen_comparison
-    from FemBspTet.freecad.mesher_tools import set_tetgen_properties
+def test_comparison_row_of_a_missing_peer(monkeypatch, tmp_path):
+    from FemBspTet.compare.at_size import gmsh_row, tetgen_row
     from FemBspTet.io.surface_io import read_surface
     from conftest import paper_path
 
-    monkeypatch.setenv("PATH", str(tmp_path))  # no tetgen on it
-    row = run_tetgen_comparison([read_surface(paper_path("schoenhardt"))])
-    assert row["status"] == "skipped" and "tetgen is not installed" in row["message"]
-    obj = FemBspTet.make_mesher(doc, None, ElementOrder="1st")
-    set_tetgen_properties(obj, row)
-    assert obj.TetGenCommand.startswith("tetgen -pY skipped: tetgen is not installed")
-    assert (obj.TetGenTetrahedra, obj.TetGenNodes, obj.TetGenValid) == (0, 0, False)
+    monkeypatch.setenv("PATH", str(tmp_path))  # no tetgen, no gmsh on it
+    row = tetgen_row(read_surface(paper_path("schoenhardt")), 1.0, 1)
+    assert row.status == "skipped" and "tetgen is not installed" in row.message
+    row = gmsh_row(str(tmp_path / "part.brep"), 1.0, 2)
+    assert row.status == "skipped" and "gmsh is not installed" in row.message
+    assert comparison_line(row) == "Gmsh (gmsh -3 -clmax 1 -order 2): skipped, gmsh is not " \
+        "installed"
 
 
 def assert_ccx_faces_are_the_boundary_faces(result, fem, shape, k):
@@ -172,7 +183,7 @@ def assert_ccx_faces_are_the_boundary_faces(result, fem, shape, k):
 def test_ccx_faces_of_a_block_with_a_hole_are_the_boundary_faces(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     for order in ("1st", "2nd"):
-        obj = FemBspTet.make_mesher(doc, part, ElementOrder=order, CompareWithTetGen=False)
+        obj = FemBspTet.make_mesher(doc, part, ElementOrder=order, CompareWithPeers=False)
         result = FemBspTet.run_mesher(obj)
         for k in range(len(part.Shape.Faces)):
             assert_ccx_faces_are_the_boundary_faces(result, obj.FemMesh, part.Shape, k)
@@ -184,7 +195,7 @@ def test_tet10_midnodes_on_a_cylinder_are_found_by_get_nodes_by_face(doc, fc):
     certified valid."""
     _, Part, _ = fc
     part = add_part(doc, fc, Part.makeCylinder(10, 30))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", CompareWithTetGen=False)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", CompareWithPeers=False)
     result = FemBspTet.run_mesher(obj)
     fem = obj.FemMesh
     assert result.mesh.tets.shape[1] == 10 and result.stats["midnodes_projected"] > 0
@@ -224,7 +235,7 @@ def test_cad_parts_tet10_on_the_cad_certified_with_face_groups(doc, fc, name, so
     part = add_part(doc, fc, Part.read(os.path.join(DATA, name)), "Cad")
     assert len(part.Shape.Solids) == solids
     obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", FaceGroups=True,
-                                CompareWithTetGen=False)
+                                CompareWithPeers=False)
     result = FemBspTet.run_mesher(obj)
     mesh = result.mesh
     assert mesh.tets.shape[1] == 10
@@ -248,7 +259,7 @@ def test_cad_parts_tet10_on_the_cad_certified_with_face_groups(doc, fc, name, so
 def test_face_groups(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", FaceGroups=True,
-                                CompareWithTetGen=False)
+                                CompareWithPeers=False)
     result = FemBspTet.run_mesher(obj)
     fem = obj.FemMesh
     groups = {fem.getGroupName(g): g for g in fem.Groups}
@@ -263,7 +274,7 @@ def test_face_groups(doc, fc):
 def test_failure_keeps_the_previous_mesh(doc, fc):
     _, Part, _ = fc
     part = add_part(doc, fc, block_with_hole(fc))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=False)
     FemBspTet.run_mesher(obj)
     before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.Nodes)
     shell = add_part(doc, fc, Part.Shell(Part.makeBox(1, 1, 1).Faces[:5]), "OpenShell")
@@ -280,7 +291,7 @@ def test_failure_keeps_the_previous_mesh(doc, fc):
 
 def test_cancel_keeps_the_previous_mesh(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=False)
     FemBspTet.run_mesher(obj)
     nodes = obj.FemMesh.NodeCount
     with pytest.raises(MeshingCancelled):
@@ -294,7 +305,7 @@ def test_sizes_are_honoured(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     counts = {}
     for h in (8.0, 4.0):
-        obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithTetGen=False,
+        obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=False,
                                     CharacteristicLengthMax=h, CharacteristicLengthMin=0.5)
         result = FemBspTet.run_mesher(obj)
         p, t = result.mesh.points, result.mesh.tets
@@ -362,7 +373,7 @@ def test_worker_process_gives_the_same_mesh_as_in_process(fc):
     from FemBspTet.freecad.mesh_worker import MeshJob
 
     shape = block_with_hole(fc)
-    params = mp.MeshParameters(order=1, compare_tetgen=False)
+    params = mp.MeshParameters(order=1, compare_peers=False)
     local = mp.mesh_cad_shape(shape, params)
     job = MeshJob(shape, params, python="/usr/bin/python3")
     job.start()
@@ -402,12 +413,19 @@ def test_save_and_reload(doc, fc, tmp_path):
     part = add_part(doc, fc, block_with_hole(fc))
     part_name = part.Name
     obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", FaceGroups=True,
-                                CharacteristicLengthMax=7.5, CompareWithTetGen=False)
+                                CharacteristicLengthMax=7.5, CompareWithPeers=False)
     FemBspTet.run_mesher(obj)
     # as in a file of an older version: the former tessellation parameters saved with it
     obj.addProperty("App::PropertyBool", "RemeshSurface", "BspTet Mesh Params", "former")
     obj.addProperty("App::PropertyLength", "LinearDeflection", "BspTet Mesh Params", "former")
     obj.RemeshSurface, obj.LinearDeflection = True, 0.25
+    # ... the former comparison's parameter (its value carries over) and results, former groups
+    obj.removeProperty("CompareWithPeers")
+    obj.addProperty("App::PropertyBool", "CompareWithTetGen", "BspTet Mesh Params", "former")
+    obj.addProperty("App::PropertyInteger", "TetGenTetrahedra", "BspTet Mesh Results", "former")
+    obj.CompareWithTetGen, obj.TetGenTetrahedra = False, 99
+    obj.setGroupOfProperty("ElementOrder", "BspTet Mesh Params")
+    obj.setGroupOfProperty("Nodes", "BspTet Mesh Results")
     fem = obj.FemMesh
     nodes = {i: tuple(v) for i, v in fem.Nodes.items()}
     vols = [fem.getElementNodes(e) for e in fem.Volumes]
@@ -429,12 +447,16 @@ def test_save_and_reload(doc, fc, tmp_path):
         # the former parameters went on opening; the object meshes as before
         assert "RemeshSurface" not in o2.PropertiesList
         assert "LinearDeflection" not in o2.PropertiesList
+        assert "CompareWithTetGen" not in o2.PropertiesList and o2.CompareWithPeers is False
+        assert "TetGenTetrahedra" not in o2.PropertiesList
+        assert o2.getGroupOfProperty("ElementOrder") == "Mesh Params"
+        assert o2.getGroupOfProperty("Nodes") == "Mesh Results"
         FemBspTet.run_mesher(o2)
         assert o2.FemMesh.NodeCount == len(nodes)
         # a restored object upgrades itself: a property missing in an old file comes back
-        o2.removeProperty("CompareWithTetGen")
+        o2.removeProperty("CompareWithPeers")
         o2.Proxy.onDocumentRestored(o2)
-        assert o2.CompareWithTetGen is True
+        assert o2.CompareWithPeers is True
     finally:
         freecad.closeDocument(d2.Name)
 
@@ -447,7 +469,7 @@ def test_object_of_0_20_files_opens_and_meshes(doc, fc, tmp_path):
     obj = doc.addObject("Fem::FemMeshObjectPython", "MeshBspTet")
     MeshBspTet(obj)
     obj.Part = part
-    obj.ElementOrder, obj.CompareWithTetGen = "1st", False
+    obj.ElementOrder, obj.CompareWithPeers = "1st", False
     name, part_name = obj.Name, part.Name
     path = str(tmp_path / "old_mesher.FCStd")
     doc.saveAs(path)
@@ -474,7 +496,7 @@ def test_export(doc, fc, tmp_path, ext):
 
     _, Part, _ = fc
     part = add_part(doc, fc, Part.makeCylinder(3, 7))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", CompareWithTetGen=False)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="2nd", CompareWithPeers=False)
     result = FemBspTet.run_mesher(obj)
     path = FemBspTet.export_mesh(obj, str(tmp_path / ("mesh" + ext)))
     back = read_via_freecad(path)

@@ -45,14 +45,12 @@ import tempfile
 import numpy as np
 from types import SimpleNamespace
 
-from ..fem.mesh_pipeline import TETGEN_SWITCHES
-from ..io import cad_tessellation
 from ..io.atomic_file import atomic_output
 from ..io.surface_io import write_surface
 from ..io.volume_io import read_tet_mesh, read_tetgen
 from ..kernel import core
 from ..kernel.core import boundary_surface
-from ..kernel.errors import BspTetError, InputError, InternalError
+from ..kernel.errors import BspTetError, InternalError
 from ..kernel.mesh_types import Surface, TetMesh
 from ..kernel.paths import ADDON_DIR
 from ..peers.gmsh import gmsh_available, gmsh_command, mean_edge_length, run_gmsh
@@ -539,31 +537,3 @@ def plot_histograms(path, result: Comparison):
     with atomic_output(path, "wb") as f:
         fig.savefig(f, format="png", dpi=80)
     plt.close(fig)
-
-
-# ------------------------------------------------------------------------------------------
-# the FreeCAD object's comparison: TetGen on OpenCASCADE's display tessellation
-# ------------------------------------------------------------------------------------------
-
-def tetgen_comparison_of(shape, max_size=0.0, source=""):
-    """``tetgen -pY`` on OpenCASCADE's display tessellation of ``shape`` (default deflection for
-    the element size, fins flipped away as ``fembsptet mesh --tessellation`` does): the
-    comparison's row as a dict. A shape OpenCASCADE cannot tessellate into closed surfaces is a
-    row with ``status`` "failed" and the reason (never raises for that)."""
-    size = max_size if max_size > 0 else None
-    try:
-        surfaces = cad_tessellation.tessellate_shape(
-            shape, cad_tessellation.default_linear_deflection(shape, size), source=source)
-    except InputError as e:
-        return row_dict(Row(mesher=TETGEN_PY, command="tetgen -%s" % TETGEN_SWITCHES,
-                            status="failed",
-                            message="OpenCASCADE's tessellation: %s" % str(e)[:300]))
-    surfaces, _ = cad_tessellation.flip_out_fins_of(surfaces)
-    return run_tetgen_comparison(surfaces)
-
-
-def run_tetgen_comparison(surfaces):
-    """``tetgen -pY`` on the surfaces: the comparison's row (:func:`FemBspTet.compare.comparison.
-    tetgen_pY_row`) as a dict; a missing or failing TetGen is a row with ``status`` and
-    ``message`` (never raises)."""
-    return row_dict(tetgen_pY_row(surfaces))

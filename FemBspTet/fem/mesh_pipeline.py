@@ -8,7 +8,7 @@ around it, without any document object.
 
 Used in-process by ``run_mesher`` / ``mesh_shape`` (:mod:`FemBspTet.freecad.mesher_tools`) and in the
 worker process of the task panel (:mod:`FemBspTet.freecad.mesh_worker`, which meshes the BREP text with
-:func:`mesh_brep` and needs FreeCAD only for the TetGen comparison).
+:func:`mesh_brep`).
 
 Stages:
 
@@ -23,8 +23,8 @@ Stages:
    tet10 boundary mid-nodes are read off the tets. They give the node groups per CAD face and
    what FreeCAD's constraints find.
 3. Quality figures of the linear tets (:func:`FemBspTet.kernel.core.tet_quality`) and notes.
-4. Optionally ``tetgen -pY`` on OpenCASCADE's display tessellation of the shape (the comparison
-   table of the task panel; our mesh is not made from that tessellation).
+4. Optionally the comparison at the same size (TetGen on our surface, Gmsh and Netgen on the CAD
+   part: :mod:`FemBspTet.compare.at_size`, handed in by the FreeCAD layer as ``compare``).
 """
 
 import dataclasses
@@ -36,7 +36,6 @@ import numpy as np
 
 from ..kernel import core
 from ..kernel.errors import Cancelled, InputError, InternalError, MeshingCancelled
-from ..kernel.freecad_env import import_freecad
 from ..kernel.mesh_types import MeshGroups, TetMesh
 from .cad_mesh import mesh_cad_brep
 
@@ -46,7 +45,7 @@ PROPERTY_OF = {
     "min_size": "CharacteristicLengthMin",
     "order": "ElementOrder",
     "face_groups": "FaceGroups",
-    "compare_tetgen": "CompareWithTetGen",
+    "compare_peers": "CompareWithPeers",
 }
 
 #: Parameters of the former tessellation pipeline, by FreeCAD property name: the FEM path meshes
@@ -73,10 +72,6 @@ REMOVED_BECAUSE = ("the mesher meshes the CAD faces itself at the element size "
 #: writer only uses groups named ``<constraint object name>_...``; this prefix avoids them.
 FACE_GROUP_PREFIX = "BspTet_"
 
-#: Switches of the TetGen run the comparison uses (``tetgen -pY``: OpenCASCADE's display
-#: tessellation filled without a Steiner point on it, no quality or size bound).
-TETGEN_SWITCHES = "pY"
-
 _TET10_EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
 #: Outward faces of a positive tet (a, b, c, d): opposite d, c, a, b.
 _OUTWARD_FACES = ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2))
@@ -100,15 +95,15 @@ class MeshParameters:
     order:          1 (tet4) or 2 (tet10, boundary mid-nodes on the CAD faces and edges).
     face_groups:    the boundary triangles as FemMesh faces, and per CAD face a face group and
                     a node group (``BspTet_Face<k>``).
-    compare_tetgen: also run ``tetgen -pY`` on OpenCASCADE's display tessellation of the shape
-                    and report its counts.
+    compare_peers:  also mesh at the same size with TetGen (on our surface), Gmsh and Netgen
+                    (on the CAD part, where installed) and report their counts, angles, times.
     """
 
     max_size: float = 0.0
     min_size: float = 0.0
     order: int = 2
-    face_groups: bool = False
-    compare_tetgen: bool = False
+    face_groups: bool = True
+    compare_peers: bool = False
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -166,8 +161,8 @@ class MeshResult:
     face_names:         ``"Face<k+1>"`` for every face of the shape.
     stats:              the FEM path's stats (``fem.cad_mesh``), the quality figures of
                         ``cli.STATS_KEYS``, ``seconds_total``.
-    tetgen:             None, or the ``tetgen -pY`` row of the comparison as a dict
-                        (:func:`FemBspTet.compare.comparison.row_dict`).
+    comparison:         rows of the comparison at the same size as dicts, ours first
+                        (:class:`FemBspTet.compare.at_size.SizeRow`), or empty.
     notes:              things the user should know.
     """
 
@@ -177,7 +172,7 @@ class MeshResult:
     boundary_midnodes: np.ndarray
     face_names: list
     stats: dict
-    tetgen: object = None
+    comparison: list = dataclasses.field(default_factory=list)
     notes: list = dataclasses.field(default_factory=list)
 
     def face_nodes(self, face_tag):
@@ -207,7 +202,8 @@ class MeshResult:
                  boundary_faces=self.boundary_faces, boundary_face_tags=self.boundary_face_tags,
                  boundary_midnodes=self.boundary_midnodes)
         with open(json_path, "w", encoding="utf-8") as f:
-            json.dump({"face_names": self.face_names, "stats": self.stats, "tetgen": self.tetgen,
+            json.dump({"face_names": self.face_names, "stats": self.stats,
+                       "comparison": self.comparison,
                        "notes": self.notes, "source": self.mesh.source}, f, default=_json_default)
 
     @classmethod
@@ -220,7 +216,8 @@ class MeshResult:
                    arrays["boundary_faces"].reshape(-1, 3),
                    arrays["boundary_face_tags"].reshape(-1),
                    arrays["boundary_midnodes"].reshape(-1, 3),
-                   meta["face_names"], meta["stats"], meta.get("tetgen"), meta.get("notes", []))
+                   meta["face_names"], meta["stats"], meta.get("comparison", []),
+                   meta.get("notes", []))
 
 
 def _json_default(value):
@@ -235,13 +232,14 @@ def _json_default(value):
 # the pipeline
 # ------------------------------------------------------------------------------------------
 
-def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", tetgen_row=None):
+def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", compare=None):
     """Mesh every solid of ``shape`` (a ``Part.Shape``) with ``params``; see the module docstring.
 
     progress: ``progress(stage, fraction)`` (fraction in [0, 1] or None), called now and then.
     cancel:   ``cancel()`` returning True stops the run with MeshingCancelled.
     source:   a name for messages (the document object's label, a file name).
-    tetgen_row: the TetGen comparison (see :func:`mesh_brep`), run if ``params.compare_tetgen``.
+    compare:  the comparison at the same size (see :func:`mesh_brep`), run if
+              ``params.compare_peers``.
 
     Returns a :class:`MeshResult`. Raises InputError (no solid, a bad parameter, a part the
     surface mesher cannot mesh: the message names the CAD face or solid), MeshingCancelled, or
@@ -254,16 +252,17 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", tetgen_
     if shape.isNull():
         raise InputError("the shape is empty: nothing to mesh", where=where)
     return mesh_brep(shape.exportBrepToString(), len(shape.Faces), params, progress=progress,
-                     cancel=cancel, source=source, shape=shape, tetgen_row=tetgen_row)
+                     cancel=cancel, source=source, shape=shape, compare=compare)
 
 
 def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", shape=None,
-              tetgen_row=None):
+              compare=None):
     """:func:`mesh_cad_shape` on the shape's BREP text ``brep`` (``Shape.exportBrepToString``)
-    with ``face_count`` faces. With ``params.compare_tetgen``, ``tetgen_row(shape, max_size,
-    source)`` (FemBspTet.compare.comparison.tetgen_comparison_of, passed by the FreeCAD layer)
-    gives the TetGen comparison's row; it needs FreeCAD (``shape``: the ``Part.Shape`` for it;
-    read from ``brep`` when None)."""
+    with ``face_count`` faces. With ``params.compare_peers``, ``compare(brep, mesh,
+    boundary_faces, size, seconds, shape=shape, progress=...)``
+    (:func:`FemBspTet.compare.at_size.compare_at_size`, handed in by the FreeCAD layer) gives
+    the comparison's rows at the size our mesh was made at (``shape``: the ``Part.Shape`` if at
+    hand)."""
 
     params = _validated(params)
     t_start = time.perf_counter()
@@ -319,15 +318,15 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
     if cancel is not None and cancel():
         raise MeshingCancelled("cancelled: no mesh was made")
 
-    tetgen = None
-    if params.compare_tetgen and tetgen_row is not None:
-        report("tetgen -%s on OpenCASCADE's tessellation" % TETGEN_SWITCHES, 0.92)
-        tetgen = tetgen_row(shape if shape is not None else _shape_of_brep(brep),
-                            params.max_size, source)
     stats["seconds_total"] = time.perf_counter() - t_start
+    comparison = []
+    if params.compare_peers and compare is not None:
+        comparison = compare(brep, mesh, faces, float(stats["size"]), stats["seconds_total"],
+                             shape=shape, progress=lambda stage: report(stage, 0.92))
     report("done", 1.0)
     return MeshResult(mesh, faces, tags, midnodes,
-                      ["Face%d" % (k + 1) for k in range(int(face_count))], stats, tetgen, notes)
+                      ["Face%d" % (k + 1) for k in range(int(face_count))], stats, comparison,
+                      notes)
 
 
 #: How the native BREP reader names its input at the start of a message.
@@ -337,16 +336,6 @@ _BREP_SOURCE = "BREP string: "
 def _validated(params):
     return params.validate() if isinstance(params, MeshParameters) else \
         MeshParameters.from_dict(dict(params))
-
-
-def _shape_of_brep(brep):
-
-    import_freecad()
-    import Part
-
-    shape = Part.Shape()
-    shape.importBrepFromString(brep)
-    return shape
 
 
 # ------------------------------------------------------------------------------------------

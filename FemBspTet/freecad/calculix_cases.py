@@ -135,7 +135,7 @@ def add_bsptet_mesh(case, max_size, order, **properties):
     """Our mesher object for the case's part, meshed (run_mesher) and added to the analysis."""
 
     obj = make_mesher(case.doc, case.part, CharacteristicLengthMax=max_size,
-                      ElementOrder="2nd" if order == 2 else "1st", CompareWithTetGen=False,
+                      ElementOrder="2nd" if order == 2 else "1st", CompareWithPeers=False,
                       **properties)
     run_mesher(obj)
     case.analysis.addObject(obj)

@@ -19,7 +19,7 @@ Job directory protocol (a private temporary directory, removed by the client):
   the topology, so the faces keep their order, and ``face_count`` in the parameters is checked
   against the faces the FEM path reads). In-process runs mesh the same BREP text
   (``mesh_pipeline.mesh_cad_shape``), so both give identical meshes. The worker starts FreeCAD
-  only for the TetGen comparison (it tessellates the shape).
+  only for the comparison at the same size, to write the part as STEP for Netgen.
 * ``parameters.json``: ``{"parameters": MeshParameters.to_dict(), "face_count": n,
   "source": label}``.
 * stdout lines ``PROGRESS <fraction or -> <stage text>`` while it runs.
@@ -41,7 +41,7 @@ import tempfile
 import threading
 import traceback
 
-from ..compare.comparison import tetgen_comparison_of
+from ..compare.at_size import compare_at_size
 from ..fem.mesh_pipeline import mesh_brep, MeshParameters, MeshResult
 from ..kernel.errors import InputError, InternalError, MeshingCancelled
 from ..peers.process import worker_env
@@ -210,7 +210,7 @@ def main(argv=None):
         with open(os.path.join(job_dir, "shape.brep"), encoding="utf-8") as f:
             brep = f.read()
         result = mesh_brep(brep, job["face_count"], params, progress=progress,
-                           source=job.get("source", ""), tetgen_row=tetgen_comparison_of)
+                           source=job.get("source", ""), compare=compare_at_size)
         result.save(os.path.join(job_dir, "result.npz"), os.path.join(job_dir, "result.json"))
         return 0
     except Exception as e:  # reported to the client through error.json

@@ -43,8 +43,11 @@ OBJECT_TYPE = "Fem::FemMeshObjectPython"
 SHAPE_LINK = "Shape"
 PART_LINK = "Part"
 
-PARAMS_GROUP = "BspTet Mesh Params"
-RESULTS_GROUP = "BspTet Mesh Results"
+#: Property groups (FreeCAD's property editor splits camel case: short plain words fit its column).
+PARAMS_GROUP = "Mesh Params"
+RESULTS_GROUP = "Mesh Results"
+#: Groups of earlier versions, renamed on restore.
+FORMER_GROUPS = ("BspTet Mesh Params", "BspTet Mesh Results")
 
 #: (type, name, group, tooltip, default) of every parameter property.
 PARAMETER_PROPERTIES = (
@@ -58,11 +61,12 @@ PARAMETER_PROPERTIES = (
      "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
      ("1st", "2nd")),
     ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
-     "Add the boundary triangles as faces, and a face group and a node group per CAD face "
-     "(BspTet_Face1, ...)", False),
-    ("App::PropertyBool", "CompareWithTetGen", PARAMS_GROUP,
-     "Also run tetgen -pY on OpenCASCADE's display tessellation of the part and show its "
-     "counts", True),
+     "Add the boundary triangles as faces (tria6 for 2nd order), and a face group and a node "
+     "group per CAD face (BspTet_Face1, ...)", True),
+    ("App::PropertyBool", "CompareWithPeers", PARAMS_GROUP,
+     "Also mesh the part at the same size with TetGen (tetgen -pq with the matching volume "
+     "bound, on this mesh's surface), Gmsh and Netgen (on the CAD part, where installed) and "
+     "show their counts, angles and times", True),
 )
 
 #: (type, name, tooltip) of every read-only result property.
@@ -75,38 +79,26 @@ RESULT_PROPERTIES = (
     ("App::PropertyInteger", "BoundarySteinerPoints",
      "Of those, the ones on the CAD faces (refinement of the surface)"),
     ("App::PropertyFloat", "MinDihedralAngle", "Smallest dihedral angle (degrees)"),
+    ("App::PropertyFloat", "MedianTetMinDihedralAngle",
+     "Median over the tetrahedra of each one's smallest dihedral angle (degrees)"),
     ("App::PropertyFloat", "MaxRadiusEdgeRatio", "Largest radius-edge ratio"),
     ("App::PropertyFloat", "MeshingTime", "Seconds of the last run (CAD to mesh)"),
     ("App::PropertyStringList", "MeshNotes", "What the mesher could not do as asked, warnings"),
-    ("App::PropertyString", "TetGenCommand",
-     "The TetGen run of the comparison (on OpenCASCADE's display tessellation)"),
-    ("App::PropertyInteger", "TetGenNodes", "TetGen's nodes on the display tessellation"),
-    ("App::PropertyInteger", "TetGenTetrahedra", "TetGen's tetrahedra on the display "
-     "tessellation"),
-    ("App::PropertyInteger", "TetGenSteinerPoints", "TetGen's Steiner points"),
-    ("App::PropertyInteger", "TetGenBoundarySteinerPoints", "TetGen's Steiner points on the "
-     "surface"),
-    ("App::PropertyFloat", "TetGenMinDihedralAngle", "Smallest dihedral angle of TetGen's mesh"),
-    ("App::PropertyFloat", "TetGenMaxRadiusEdgeRatio", "Largest radius-edge ratio of TetGen's "
-     "mesh"),
-    ("App::PropertyFloat", "TetGenTime", "TetGen's seconds"),
-    ("App::PropertyFloat", "TetGenPeakMemory", "Peak memory of the TetGen process (MB)"),
-    ("App::PropertyBool", "TetGenValid", "Our exact checker accepts TetGen's mesh"),
+    ("App::PropertyStringList", "Comparison",
+     "The same part at the same size: this mesh, TetGen's, Gmsh's and Netgen's (nodes, "
+     "tetrahedra, smallest and median per-tet smallest dihedral angle, seconds)"),
+    ("App::PropertyString", "ComparisonData", "The comparison's rows as JSON (the task panel's "
+     "table)"),
 )
-
-#: Result property of each field of a comparison row (``compare.comparison.Row``), for our mesh
-#: and for TetGen's: ``mesher_tools.apply_result`` fills them, the task panel's table reads them.
-ROW_PROPERTIES = {
-    "ours": {"nodes": "Nodes", "tets": "Tetrahedra", "steiner_points": "SteinerPoints",
-             "steiner_boundary": "BoundarySteinerPoints", "min_dihedral_deg": "MinDihedralAngle",
-             "max_radius_edge_ratio": "MaxRadiusEdgeRatio", "seconds": "MeshingTime"},
-    "tetgen-pY": {"command": "TetGenCommand", "nodes": "TetGenNodes", "tets": "TetGenTetrahedra",
-                  "steiner_points": "TetGenSteinerPoints",
-                  "steiner_boundary": "TetGenBoundarySteinerPoints",
-                  "min_dihedral_deg": "TetGenMinDihedralAngle",
-                  "max_radius_edge_ratio": "TetGenMaxRadiusEdgeRatio", "seconds": "TetGenTime",
-                  "peak_rss_mb": "TetGenPeakMemory", "valid": "TetGenValid"},
-}
+#: Result properties of earlier versions (a comparison with an unsized tetgen -pY), removed on
+#: restore.
+FORMER_RESULTS = ("TetGenCommand", "TetGenNodes", "TetGenTetrahedra", "TetGenSteinerPoints",
+                  "TetGenBoundarySteinerPoints", "TetGenMinDihedralAngle",
+                  "TetGenMaxRadiusEdgeRatio", "TetGenTime", "TetGenPeakMemory", "TetGenValid")
+#: A parameter of earlier versions whose value carries over to its successor on restore.
+RENAMED_PARAMETERS = {"CompareWithTetGen": "CompareWithPeers"}
+#: Hidden in the property editor.
+HIDDEN_RESULTS = ("ComparisonData",)
 
 
 def object_type(doc):
@@ -150,29 +142,47 @@ def _migrate_part_to_shape(obj):
 
 
 def add_properties(obj):
-    """Add every missing property of the mesher object, and remove the parameters of the
-    former tessellation pipeline (``mesh_pipeline.REMOVED_PARAMETERS``) from objects of older
-    files, saying so on the console. Used on creation and to upgrade restored objects. Returns
-    the names removed."""
+    """Add every missing property of the mesher object; on objects of older files also remove
+    the parameters of the former tessellation pipeline (``mesh_pipeline.REMOVED_PARAMETERS``)
+    and the former comparison's results, carry renamed parameters over and move properties out
+    of former groups. Used on creation and to upgrade restored objects. Returns the names of
+    the parameters removed."""
 
     removed = [name for name in REMOVED_PARAMETERS.values() if name in obj.PropertiesList]
     for name in removed:
         obj.removeProperty(name)
+    for name in FORMER_RESULTS:
+        if name in obj.PropertiesList:
+            obj.removeProperty(name)
+    carried = {new: getattr(obj, old) for old, new in RENAMED_PARAMETERS.items()
+               if old in obj.PropertiesList}
+    for old in RENAMED_PARAMETERS:
+        if old in obj.PropertiesList:
+            obj.removeProperty(old)
     existing = set(obj.PropertiesList)
     for kind, name, group, tip, default in PARAMETER_PROPERTIES:
-        if name in existing or (name == PART_LINK and source_property(obj) == SHAPE_LINK):
+        if name == PART_LINK and source_property(obj) == SHAPE_LINK:
+            continue
+        if name in existing:
+            _move_to_group(obj, name, group)
             continue
         obj.addProperty(kind, name, group, tip)
         if kind == "App::PropertyEnumeration":
             setattr(obj, name, list(default))
             setattr(obj, name, default[-1])
         elif default is not None:
-            setattr(obj, name, default)
+            setattr(obj, name, carried.get(name, default))
     for kind, name, tip in RESULT_PROPERTIES:
         if name not in existing:
             obj.addProperty(kind, name, RESULTS_GROUP, tip)
-        obj.setEditorMode(name, 1)  # read-only in the property editor
+        _move_to_group(obj, name, RESULTS_GROUP)
+        obj.setEditorMode(name, 2 if name in HIDDEN_RESULTS else 1)  # hidden / read-only
     return removed
+
+
+def _move_to_group(obj, name, group):
+    if obj.getGroupOfProperty(name) in FORMER_GROUPS:
+        obj.setGroupOfProperty(name, group)
 
 
 class StatelessProxy:

@@ -11,14 +11,16 @@ went wrong. The task panel runs the same pipeline in a worker process
 (:mod:`FemBspTet.freecad.mesh_worker`) and hands the result to :func:`apply_result` on the GUI thread.
 """
 
+import json
 import os
 
-from ..compare.comparison import tetgen_comparison_of
+
+from ..compare.at_size import compare_at_size, SizeRow
 from ..fem.mesh_pipeline import (FACE_GROUP_PREFIX, mesh_cad_shape, MeshParameters, PROPERTY_OF,
                                  removed_parameter_message, REMOVED_PARAMETERS)
 from ..kernel.errors import InputError
 from .femmesh import tetmesh_to_femmesh, write_femmesh
-from .mesher_object import RESULT_PROPERTIES, ROW_PROPERTIES, source_of, source_property
+from .mesher_object import source_of, source_property
 
 #: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
 EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
@@ -31,7 +33,7 @@ def parameters_from_object(obj):
         min_size=float(obj.CharacteristicLengthMin.Value),
         order=1 if obj.ElementOrder == "1st" else 2,
         face_groups=bool(obj.FaceGroups),
-        compare_tetgen=bool(obj.CompareWithTetGen),
+        compare_peers=bool(obj.CompareWithPeers),
     ).validate()
 
 
@@ -58,7 +60,7 @@ def run_mesher(obj, progress=None, cancel=None):
     try:
         params = parameters_from_object(obj)
         result = mesh_cad_shape(shape_of(obj), params, progress=progress, cancel=cancel,
-                                tetgen_row=tetgen_comparison_of,
+                                compare=compare_at_size,
                                 source=obj.Label)
     except Exception as e:  # every failure is recorded; the error itself goes on up
         record_failure(obj, e)
@@ -93,33 +95,31 @@ def apply_result(obj, result, femmesh=None):
     obj.MinDihedralAngle = float(st.get("min_dihedral_deg") or 0.0)
     obj.MaxRadiusEdgeRatio = float(st.get("max_radius_edge_ratio") or 0.0)
     obj.MeshingTime = float(st.get("seconds_total") or 0.0)
+    obj.MedianTetMinDihedralAngle = float(st.get("median_tet_min_dihedral_deg") or 0.0)
     obj.MeshNotes = [str(n) for n in result.notes]
-    set_tetgen_properties(obj, result.tetgen)
+    obj.Comparison = [comparison_line(SizeRow.from_dict(r)) for r in result.comparison]
+    obj.ComparisonData = json.dumps(result.comparison)
     obj.MeshStatus = "meshed: %d nodes, %d %s" % (
         obj.Nodes, obj.Tetrahedra, "tet10" if result.mesh.tets.shape[1] == 10 else "tet4")
 
 
-def set_tetgen_properties(obj, row):
-    """The TetGen result properties from the comparison's ``tetgen -pY`` row (a dict,
-    :func:`FemBspTet.compare.comparison.row_dict`), or cleared when ``row`` is None. A row
-    without a mesh leaves the figures 0 and says why in ``TetGenCommand``."""
+def comparison_line(row):
+    """One line of the ``Comparison`` property for a :class:`SizeRow`."""
+    if row.status != "ok":
+        return "%s (%s): %s, %s" % (row.mesher, row.command, row.status, row.message)
+    return ("%s (%s): %d nodes, %d tetrahedra, smallest angle %.1f°, median per-tet smallest "
+            "%.1f°, %.2f s" % (row.mesher, row.command, row.nodes, row.tets,
+                               row.min_dihedral_deg, row.median_tet_min_dihedral_deg,
+                               row.seconds))
 
-    kinds = {name: kind for kind, name, _tip in RESULT_PROPERTIES}
-    row = row or {}
-    for field, prop in ROW_PROPERTIES["tetgen-pY"].items():
-        value = row.get(field) if row.get("status", "ok") == "ok" else None
-        kind = kinds[prop]
-        if kind == "App::PropertyString":
-            value = str(row.get(field) or "")
-            if row.get("status", "ok") != "ok":
-                value += " %s: %s" % (row["status"], row.get("message", ""))
-        elif kind == "App::PropertyInteger":
-            value = int(value or 0)
-        elif kind == "App::PropertyFloat":
-            value = float(value or 0.0)
-        else:
-            value = bool(value)
-        setattr(obj, prop, value)
+
+def comparison_rows(obj):
+    """The comparison's rows (:class:`SizeRow`) stored on the object, ours first; empty when it
+    was not run."""
+    try:
+        return [SizeRow.from_dict(r) for r in json.loads(obj.ComparisonData or "[]")]
+    except (ValueError, TypeError):
+        return []
 
 
 def mesh_shape(shape, **options):
@@ -131,7 +131,7 @@ def mesh_shape(shape, **options):
     (``LinearDeflection``, ``RemeshSurface``, ...) are refused with the reason. Raises
     InputError / InternalError with a message.
     """
-    params = MeshParameters(compare_tetgen=False).to_dict()
+    params = MeshParameters(compare_peers=False).to_dict()
     field_of = {prop: field for field, prop in PROPERTY_OF.items()}
     field_of.update({prop: field for field, prop in REMOVED_PARAMETERS.items()})
     removed = [key for key in options if field_of.get(key, key) in REMOVED_PARAMETERS]
@@ -143,7 +143,7 @@ def mesh_shape(shape, **options):
             value = {"1st": 1, "2nd": 2}.get(value, value)
         params[field] = value
     params = MeshParameters.from_dict(params)
-    result = mesh_cad_shape(shape, params, tetgen_row=tetgen_comparison_of)
+    result = mesh_cad_shape(shape, params)
     return femmesh_of(result, params.face_groups)
 
 

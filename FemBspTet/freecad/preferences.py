@@ -26,8 +26,8 @@ def object_defaults():
     g = _group()
     return {
         "ElementOrder": "1st" if g.GetInt("ElementOrder", 1) == 0 else "2nd",
-        "CompareWithTetGen": g.GetBool("CompareWithTetGen", True),
-        "FaceGroups": g.GetBool("FaceGroups", False),
+        "CompareWithPeers": g.GetBool("CompareWithPeers", True),
+        "FaceGroups": g.GetBool("FaceGroups", True),
     }
 
 

@@ -47,7 +47,13 @@ class CommandMeshBspTetFromShape:
         import FreeCAD
         import FreeCADGui
 
-        part = FreeCADGui.Selection.getSelection()[0]
+        sel = FreeCADGui.Selection.getSelection()
+        if not self.IsActive():  # reached through a menu entry of ours (FreeCAD 0.20/0.21)
+            FreeCAD.Console.PrintWarning(
+                "FemBspTet: select one object with a solid (a Part, Body or imported STEP) "
+                "first, then %s\n" % MENU_TEXT)
+            return
+        part = sel[0]
         doc = FreeCAD.ActiveDocument
         doc.openTransaction("Create FEM mesh by BspTet")
         FreeCADGui.addModule("FemBspTet")
@@ -147,6 +153,9 @@ def add_to_fem_mesh_menu(holder):
     action.setObjectName(COMMAND_NAME)
     action.setToolTip(TOOL_TIP)
     action.triggered.connect(lambda: FreeCADGui.runCommand(COMMAND_NAME))
+    # enabled as FreeCAD enables commands: only with one solid selected
+    menu.aboutToShow.connect(lambda: action.setEnabled(CommandMeshBspTetFromShape().IsActive()))
+    action.setEnabled(CommandMeshBspTetFromShape().IsActive())
     actions = menu.actions()
     names = [a.objectName() for a in actions]
     if GMSH_COMMAND in names and names.index(GMSH_COMMAND) + 1 < len(actions):

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Task panel of the BspTet mesher object: parameters, Apply/OK/Cancel, progress, Stop, the stats
-and the TetGen comparison table.
+and the comparison at the same size (our mesh, TetGen's, Gmsh's and Netgen's: a column each).
 
 * Apply writes the parameters to the object and meshes in a worker process
   (:class:`FemBspTet.freecad.mesh_worker.MeshJob`): the GUI thread only polls it from a QTimer, so
@@ -10,21 +10,81 @@ and the TetGen comparison table.
   the panel's status line, and to ``obj.MeshStatus``.
 * The mesh is set on the object on the GUI thread, in one undo transaction.
 * OK writes the parameters and closes; it is refused while a run is going (Stop it first).
+* The panel fits FreeCAD's default combo view width (short labels, wrapping texts, one short
+  column per mesher); the lengths are FreeCAD quantities in the user's units.
 """
 
 import time
 
-from ..compare.comparison import COLUMNS, OURS, Row, TETGEN_PY
+from ..compare.at_size import OURS, PEERS
 from ..freecad.mesh_worker import MeshJob
-from ..freecad.mesher_object import ROW_PROPERTIES
-from ..freecad.mesher_tools import apply_result, parameters_from_object, record_failure, shape_of
+from ..freecad.mesher_tools import (apply_result, comparison_rows, parameters_from_object,
+                                    record_failure, shape_of)
 from ..kernel.errors import BspTetError, InternalError, MeshingCancelled
 
-#: Fields of the comparison rows the table shows (``compare.comparison.COLUMNS``; the values
-#: come from the object's result properties, ``mesher_object.ROW_PROPERTIES``).
-TABLE_FIELDS = ("nodes", "tets", "steiner_interior", "steiner_boundary", "min_dihedral_deg",
-                "max_radius_edge_ratio", "seconds", "valid")
+def compact_count(n):
+    """A count in at most five characters: 9094, 14.1k, 1.23M."""
+    n = int(n)
+    if n < 10000:
+        return str(n)
+    if n < 999500:
+        return "%.3gk" % (n / 1e3)
+    return "%.3gM" % (n / 1e6)
+
+
+#: Rows of the comparison table: (header, tooltip, cell text of a SizeRow).
+TABLE_ROWS = (
+    ("nodes", "Nodes (mid-nodes included)", lambda r: compact_count(r.nodes)),
+    ("tets", "Tetrahedra", lambda r: compact_count(r.tets)),
+    ("min°", "Smallest dihedral angle (degrees)", lambda r: "%.1f" % r.min_dihedral_deg),
+    ("med°", "Median over the tetrahedra of each one's smallest dihedral angle (degrees)",
+     lambda r: "%.1f" % r.median_tet_min_dihedral_deg),
+    ("s", "Seconds", lambda r: "%.2f" % r.seconds if r.seconds < 10 else
+     "%.1f" % r.seconds if r.seconds < 100 else "%d" % r.seconds),
+)
+#: Columns of the comparison table: (header, mesher of the comparison rows).
+TABLE_MESHERS = (("ours", OURS),) + tuple((peer, peer) for peer in PEERS)
 POLL_INTERVAL_MS = 100
+#: The comparison table's font, relative to the panel's.
+TABLE_FONT_SCALE = 0.8
+#: Contents margins of the panel's group boxes (left, top, right, bottom), in pixels.
+MARGINS = (4, 6, 4, 4)
+
+
+class LengthField:
+    """A length in FreeCAD's units (``Gui::InputField``, as FEM's Gmsh panel), holding the exact
+    value it was given until the user edits it: an unedited field never rounds the property to
+    the digits it shows. ``value()`` / ``setValue()`` in mm."""
+
+    def __init__(self, tip):
+        import FreeCADGui
+        from PySide import QtCore
+
+        self.widget = FreeCADGui.UiLoader().createWidget("Gui::InputField")
+        self.widget.setProperty("unit", "mm")
+        self.widget.setProperty("minimum", 0.0)
+        self.widget.setToolTip(tip)
+        self.widget.setMinimumWidth(80)  # the field's own hint is wider than the combo view needs
+        self._value = 0.0
+        QtCore.QObject.connect(self.widget, QtCore.SIGNAL("valueChanged(Base::Quantity)"),
+                               self._edited)
+
+    def _edited(self, quantity):
+        self._value = float(quantity.Value)
+
+    def value(self):
+        return self._value
+
+    def setValue(self, mm):
+        import FreeCAD
+
+        self._value = float(mm)
+        self.widget.blockSignals(True)
+        try:
+            self.widget.setText(FreeCAD.Units.Quantity(self._value, FreeCAD.Units.Length)
+                                .UserString)
+        finally:
+            self.widget.blockSignals(False)
 
 
 class TaskPanelMeshBspTet:
@@ -45,75 +105,105 @@ class TaskPanelMeshBspTet:
     # ---------------------------------------------------------------- form
 
     def _build_form(self):
-        from PySide import QtGui
+        """Narrow enough for FreeCAD's default combo view: short labels, texts that wrap, the
+        comparison as one short column per mesher."""
+        from PySide import QtCore, QtGui
 
         form = QtGui.QWidget()
-        form.setWindowTitle("BspTet mesh parameters")
+        form.setWindowTitle("BspTet mesh")
         layout = QtGui.QVBoxLayout(form)
+        layout.setContentsMargins(0, 0, 0, 0)  # the task box has its own
 
         params = QtGui.QGroupBox("Parameters")
         grid = QtGui.QFormLayout(params)
-        self.sb_max = self._length_box(
-            grid, "Max element size", "0 = automatic: the bounding-box diagonal / 20; curved "
-            "faces and edges get smaller elements", "automatic")
-        self.sb_min = self._length_box(grid, "Min element size",
-                                       "0 = automatic: the max element size / 50", "automatic")
+        grid.setContentsMargins(*MARGINS)
+        grid.setRowWrapPolicy(QtGui.QFormLayout.WrapLongRows)
+        self.sb_max = LengthField("Largest element size; 0 = automatic: the bounding-box "
+                                  "diagonal / 20. Curved faces and edges get smaller elements")
+        self.sb_min = LengthField("Smallest element size; 0 = automatic: the max size / 50")
+        grid.addRow("Max size:", self.sb_max.widget)
+        grid.addRow("Min size:", self.sb_min.widget)
         self.cb_order = QtGui.QComboBox()
         self.cb_order.addItems(["1st", "2nd"])
-        grid.addRow("Element order", self.cb_order)
-        self.ck_groups = QtGui.QCheckBox("Face and node groups per CAD face")
-        self.ck_tetgen = QtGui.QCheckBox("Compare with tetgen -pY")
-        self.ck_tetgen.setToolTip("tetgen -pY on OpenCASCADE's display tessellation of the part "
-                                  "(our mesh is made from the CAD faces themselves)")
-        for ck in (self.ck_groups, self.ck_tetgen):
+        grid.addRow("Order:", self.cb_order)
+        self.ck_groups = QtGui.QCheckBox("Face groups")
+        self.ck_groups.setToolTip("The boundary triangles as FemMesh faces (tria6 for 2nd "
+                                  "order), a face group and a node group per CAD face")
+        self.ck_compare = QtGui.QCheckBox("Compare with peers")
+        self.ck_compare.setToolTip("Also mesh the part at the same size with TetGen (tetgen -pq "
+                                   "with the matching volume bound, on this mesh's surface), "
+                                   "Gmsh and Netgen (on the CAD part, where installed)")
+        for ck in (self.ck_groups, self.ck_compare):
             grid.addRow(ck)
         layout.addWidget(params)
 
         run = QtGui.QGroupBox("Meshing")
-        run_layout = QtGui.QVBoxLayout(run)
+        run_layout = QtGui.QGridLayout(run)
+        run_layout.setContentsMargins(*MARGINS)
         self.progress = QtGui.QProgressBar()
         self.progress.setRange(0, 1000)
         self.progress.setValue(0)
-        self.status = QtGui.QLabel("Apply meshes the part.")
-        self.status.setWordWrap(True)
-        self.bt_stop = QtGui.QPushButton("Stop meshing")
+        self.progress.setTextVisible(False)  # a percentage only while a run goes on
+        self.bt_stop = QtGui.QPushButton("Stop")
+        self.bt_stop.setToolTip("Stop meshing; the previous mesh is kept")
         self.bt_stop.setEnabled(False)
         self.bt_stop.clicked.connect(self.stop_meshing)
-        run_layout.addWidget(self.progress)
-        run_layout.addWidget(self.status)
-        run_layout.addWidget(self.bt_stop)
+        self.status = QtGui.QLabel("Apply meshes the part.")
+        self.status.setWordWrap(True)
+        run_layout.addWidget(self.progress, 0, 0)
+        run_layout.addWidget(self.bt_stop, 0, 1)
+        run_layout.addWidget(self.status, 1, 0, 1, 2)
         layout.addWidget(run)
 
         res = QtGui.QGroupBox("Result")
         res_layout = QtGui.QVBoxLayout(res)
+        res_layout.setContentsMargins(0, MARGINS[1], 0, 0)  # the table's own frame is enough
         self.stats = QtGui.QLabel("")
         self.stats.setWordWrap(True)
         self.stats.setTextInteractionFlags(self.stats.textInteractionFlags() | 1)
-
-        headers = dict((key, head) for key, head, _fmt in COLUMNS)
-        self.table = QtGui.QTableWidget(len(TABLE_FIELDS), 2)
-        self.table.setHorizontalHeaderLabels(["FemBspTet", "tetgen -pY"])
-        self.table.setVerticalHeaderLabels([headers[k] for k in TABLE_FIELDS])
+        self.table = QtGui.QTableWidget(len(TABLE_ROWS), len(TABLE_MESHERS))
+        self.table.setHorizontalHeaderLabels([head for head, _mesher in TABLE_MESHERS])
+        for row, (head, tip, _cell) in enumerate(TABLE_ROWS):
+            item = QtGui.QTableWidgetItem(head)
+            item.setToolTip(tip)
+            self.table.setVerticalHeaderItem(row, item)
         self.table.setEditTriggers(QtGui.QAbstractItemView.NoEditTriggers)
-        rows_height = sum(self.table.rowHeight(r) for r in range(len(TABLE_FIELDS)))
-        self.table.setMinimumHeight(rows_height + self.table.horizontalHeader().height() + 4)
+        self.table.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
+        self.table.setVerticalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
+        self.table.verticalHeader().setDefaultSectionSize(
+            self.table.fontMetrics().height() + 6)
+        self.table.horizontalHeader().setMinimumSectionSize(8)
+        small = self.table.font()
+        small.setPointSizeF(small.pointSizeF() * TABLE_FONT_SCALE)
+        for part in (self.table, self.table.horizontalHeader(), self.table.verticalHeader()):
+            part.setFont(small)
         res_layout.addWidget(self.stats)
         res_layout.addWidget(self.table)
         layout.addWidget(res)
+        layout.addStretch(1)
         return form
 
-    @staticmethod
-    def _length_box(grid, label, tip, zero_text):
-        from PySide import QtGui
+    def _fit_table(self):
+        """Each column as wide as its widest text, the table as tall as its rows: all of it
+        visible without scrolling, in little width."""
+        t = self.table
+        metrics = t.fontMetrics()
+        pad = metrics.averageCharWidth() // 2 + 2
 
-        sb = QtGui.QDoubleSpinBox()
-        sb.setSpecialValueText(zero_text)
-        sb.setRange(0.0, 1e9)
-        sb.setDecimals(4)
-        sb.setSuffix(" mm")
-        sb.setToolTip(tip)
-        grid.addRow(label, sb)
-        return sb
+        def width(text):
+            return metrics.boundingRect(text).width() + pad
+
+        for c in range(t.columnCount()):
+            texts = [t.horizontalHeaderItem(c).text()] + \
+                [t.item(r, c).text() for r in range(t.rowCount()) if t.item(r, c) is not None]
+            t.setColumnWidth(c, max(width(x) for x in texts))
+        t.verticalHeader().setFixedWidth(max(
+            width(t.verticalHeaderItem(r).text()) for r in range(t.rowCount())))
+        frame = 2 * t.frameWidth()
+        t.setFixedHeight(t.horizontalHeader().height() + frame + sum(
+            t.rowHeight(r) for r in range(t.rowCount())))
+        t.setFixedWidth(t.verticalHeader().width() + frame + sum(
+            t.columnWidth(c) for c in range(t.columnCount())))
 
     # ---------------------------------------------------------------- parameters
 
@@ -123,15 +213,17 @@ class TaskPanelMeshBspTet:
         self.sb_min.setValue(o.CharacteristicLengthMin.Value)
         self.cb_order.setCurrentIndex(0 if o.ElementOrder == "1st" else 1)
         self.ck_groups.setChecked(bool(o.FaceGroups))
-        self.ck_tetgen.setChecked(bool(o.CompareWithTetGen))
+        self.ck_compare.setChecked(bool(o.CompareWithPeers))
 
     def store_parameters(self):
         o = self.obj
-        o.CharacteristicLengthMax = self.sb_max.value()
-        o.CharacteristicLengthMin = self.sb_min.value()
+        for prop, field in (("CharacteristicLengthMax", self.sb_max),
+                            ("CharacteristicLengthMin", self.sb_min)):
+            if getattr(o, prop).Value != field.value():
+                setattr(o, prop, field.value())
         o.ElementOrder = self.cb_order.currentText()
         o.FaceGroups = self.ck_groups.isChecked()
-        o.CompareWithTetGen = self.ck_tetgen.isChecked()
+        o.CompareWithPeers = self.ck_compare.isChecked()
 
     # ---------------------------------------------------------------- task dialog API
 
@@ -199,6 +291,7 @@ class TaskPanelMeshBspTet:
             record_failure(self.obj, e)
             return False
         self.progress.setRange(0, 0)
+        self.progress.setTextVisible(True)
         self.status.setText("Starting the meshing worker...")
         self.bt_stop.setEnabled(True)
         self._timer.start()
@@ -217,6 +310,7 @@ class TaskPanelMeshBspTet:
         self.bt_stop.setEnabled(False)
         self.progress.setRange(0, 1000)
         self.progress.setValue(0)
+        self.progress.setTextVisible(False)
         self.last_error = MeshingCancelled("cancelled: no mesh was made")
         self.status.setText("Stopped. The previous mesh is kept.")
         FreeCAD.Console.PrintMessage("FemBspTet: meshing of %s stopped; previous mesh kept\n"
@@ -239,6 +333,7 @@ class TaskPanelMeshBspTet:
         job, self.job = self.job, None
         self.bt_stop.setEnabled(False)
         self.progress.setRange(0, 1000)
+        self.progress.setTextVisible(False)
         try:
             result = job.result()
         except Exception as e:  # the worker's error, or unreadable result files
@@ -296,55 +391,53 @@ class TaskPanelMeshBspTet:
     # ---------------------------------------------------------------- results
 
     def _show_object_results(self):
-        """Stats and comparison table from the object's result properties."""
-        from PySide import QtGui
+        """Stats, status, progress and the comparison table from the object's result
+        properties (also when the panel is reopened on an old mesh)."""
+        from PySide import QtCore, QtGui
 
         o = self.obj
         if not o.Nodes:
             self.stats.setText("Not meshed yet.")
         else:
-            lines = ["%d nodes, %d tetrahedra (%s), %d Steiner points (%d on the surface)"
-                     % (o.Nodes, o.Tetrahedra, o.ElementOrder, o.SteinerPoints,
-                        o.BoundarySteinerPoints),
-                     "dihedral angles from %.2f°, radius-edge ratio up to %.3g; %.2f s"
-                     % (o.MinDihedralAngle, o.MaxRadiusEdgeRatio, o.MeshingTime)]
+            lines = ["%d nodes, %d tetrahedra (%s order)" % (o.Nodes, o.Tetrahedra,
+                                                              o.ElementOrder),
+                     "smallest dihedral angle %.1f°, median per-tet smallest %.1f°"
+                     % (o.MinDihedralAngle, o.MedianTetMinDihedralAngle),
+                     "%d points added to the surface mesh (%d on the CAD faces); %.1f s"
+                     % (o.SteinerPoints, o.BoundarySteinerPoints, o.MeshingTime)]
             lines += ["note: %s" % n for n in o.MeshNotes]
             self.stats.setText("\n".join(lines))
-        ours, tetgen = object_rows(o)
-        for row, field in enumerate(TABLE_FIELDS):
-            for col, r in enumerate((ours, tetgen)):
-                text = r.cell(field) if r is not None else "-"
-                self.table.setItem(row, col, QtGui.QTableWidgetItem(text))
-        if o.TetGenCommand:
-            self.table.setToolTip(o.TetGenCommand)
+            if not self.running:
+                self.progress.setValue(1000 if o.MeshStatus.startswith("meshed") else 0)
+                self.status.setText(o.MeshStatus if o.MeshStatus.startswith("meshed") else
+                                    "%s\nThe mesh shown is the one before." % o.MeshStatus)
+        rows = {r.mesher: r for r in comparison_rows(o)}
+        tips = []
+        for col, (head, mesher) in enumerate(TABLE_MESHERS):
+            r = rows.get(mesher)
+            about = "" if r is None else r.command if r.status == "ok" else \
+                "%s (%s)" % (r.status, r.message)
+            for row, (_head, _tip, cell) in enumerate(TABLE_ROWS):
+                item = QtGui.QTableWidgetItem(cell(r) if r is not None and r.status == "ok"
+                                              else "-")
+                item.setTextAlignment(int(QtCore.Qt.AlignRight | QtCore.Qt.AlignVCenter))
+                item.setToolTip("%s: %s" % (mesher, about) if about else mesher)
+                self.table.setItem(row, col, item)
+            if about:
+                tips.append("%s: %s" % (head, about))
+        self.table.setToolTip("\n".join(tips))
+        self._fit_table()
 
     def comparison_table(self):
-        """The table's cells as text rows (label, ours, TetGen): for tests and scripts."""
-        rows = []
-        for row in range(self.table.rowCount()):
-            cells = [self.table.item(row, c) for c in (0, 1)]
-            label = self.table.verticalHeaderItem(row).text()
-            rows.append((label,) + tuple(c.text() if c is not None else "" for c in cells))
+        """The table's cells as text rows (header, then one cell per mesher; the first row is
+        ``("", "ours", "TetGen", ...)``): for tests and scripts."""
+        t = self.table
+        rows = [("",) + tuple(t.horizontalHeaderItem(c).text() for c in range(t.columnCount()))]
+        for row in range(t.rowCount()):
+            cells = [t.item(row, c) for c in range(t.columnCount())]
+            rows.append((t.verticalHeaderItem(row).text(),) +
+                        tuple(c.text() if c is not None else "" for c in cells))
         return rows
-
-
-def object_rows(obj):
-    """``(ours, tetgen)``: comparison rows (``compare.comparison.Row``) rebuilt from the
-    object's result properties, or None for a side without a mesh."""
-
-    rows = []
-    for mesher, present in ((OURS, obj.Nodes > 0), (TETGEN_PY, obj.TetGenTetrahedra > 0)):
-        if not present:
-            rows.append(None)
-            continue
-        props = ROW_PROPERTIES[mesher]
-        values = {f: getattr(obj, p) for f, p in props.items() if f != "steiner_points"}
-        values["steiner_interior"] = getattr(obj, props["steiner_points"]) - \
-            values["steiner_boundary"]
-        values.setdefault("valid", True)  # ours: checked exactly before it is returned
-        values.setdefault("command", "fembsptet")
-        rows.append(Row(mesher=mesher, **values))
-    return tuple(rows)
 
 
 def _as_bsptet_error(error):

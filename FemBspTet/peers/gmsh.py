@@ -162,3 +162,37 @@ def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None, name="s
     finally:
         if keep_dir is None:
             shutil.rmtree(workdir, ignore_errors=True)
+
+
+def gmsh_cad_command(size, order):
+    return f"gmsh -3 -clmax {size:.4g} -order {int(order)}"
+
+
+def run_gmsh_cad(part, size, order=2, timeout=None, keep_dir=None, name="part") -> GmshResult:
+    """Gmsh on the CAD file ``part`` (STEP, IGES, BREP) at ``CharacteristicLengthMax = size``,
+    ``order`` 1 or 2: ``gmsh PART -3 -clmax SIZE -order ORDER -nt 1``, Gmsh's defaults otherwise
+    (what FreeCAD's Gmsh mesher runs with ``CharacteristicLengthMax`` set). The tets come back
+    with the corners first (tet10 in Gmsh's order). Raises InternalError as :func:`run_gmsh`."""
+    exe = gmsh_path()
+    if exe is None:
+        raise InternalError("gmsh is not installed (Debian package gmsh); run scripts/setup.sh")
+    workdir = keep_dir or tempfile.mkdtemp(prefix="fembsptet_gmsh_")
+    try:
+        out = os.path.join(workdir, name + ".gmsh.msh")
+        run = run_measured([exe, os.path.abspath(part), "-3", "-clmax", repr(float(size)),
+                            "-order", str(int(order)), "-nt", "1", "-format", "msh22",
+                            "-o", out], timeout=timeout, cwd=workdir)
+        if run.timed_out:
+            raise InternalError(f"gmsh timed out after {timeout:g} s")
+        errors = [ln for ln in run.output.splitlines() if ln.startswith("Error")]
+        if run.returncode != 0 or errors or not os.path.exists(out):
+            raise InternalError(f"gmsh failed (exit {run.returncode}): "
+                                + ("; ".join(errors[:3]) or run.tail()))
+        mesh = read_tet_mesh(out)
+        if len(mesh.tets) == 0:
+            raise InternalError("gmsh made no tetrahedra: " + run.tail())
+        return GmshResult(mesh=mesh, command=gmsh_cad_command(size, order), seconds=run.seconds,
+                          peak_rss_mb=run.peak_rss_mb, output=run.output, mesh_path=out)
+    finally:
+        if keep_dir is None:
+            shutil.rmtree(workdir, ignore_errors=True)

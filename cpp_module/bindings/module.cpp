@@ -58,6 +58,7 @@ py::dict quality_dict(const QualityStats& q) {
   d["max_dihedral_deg"] = q.max_dihedral_deg;
   d["p1_dihedral_deg"] = q.p1_dihedral_deg;
   d["median_dihedral_deg"] = q.median_dihedral_deg;
+  d["median_tet_min_dihedral_deg"] = q.median_tet_min_dihedral_deg;
   d["max_radius_edge_ratio"] = q.max_radius_edge_ratio;
   d["median_radius_edge_ratio"] = q.median_radius_edge_ratio;
   d["dihedral_histogram"] = q.dihedral_histogram;

@@ -202,6 +202,8 @@ QualityStats tet_quality(const TetMesh& mesh) {
   angles.reserve(static_cast<std::size_t>(nk) * 6);
   std::vector<double> ratios;
   ratios.reserve(nk);
+  std::vector<double> tet_min_angles;
+  tet_min_angles.reserve(nk);
   constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   for (Index t = 0; t < nk; ++t) {
     std::array<std::array<double, 3>, 4> p{};
@@ -238,6 +240,7 @@ QualityStats tet_quality(const TetMesh& mesh) {
       for (int k = 0; k < 3; ++k) l2 += (p[e[1]][k] - p[e[0]][k]) * (p[e[1]][k] - p[e[0]][k]);
       min_edge2 = std::min(min_edge2, l2);
     }
+    tet_min_angles.push_back(*std::min_element(angles.end() - 6, angles.end()));
     // Circumradius from the three edge vectors at vertex 0.
     std::array<double, 3> a{}, b{}, c{};
     for (int k = 0; k < 3; ++k) {
@@ -273,6 +276,7 @@ QualityStats tet_quality(const TetMesh& mesh) {
   q.min_dihedral_deg = *std::min_element(angles.begin(), angles.end());
   q.max_dihedral_deg = *std::max_element(angles.begin(), angles.end());
   q.p1_dihedral_deg = quantile(angles, 0.01);
+  q.median_tet_min_dihedral_deg = quantile(tet_min_angles, 0.5);
   q.median_dihedral_deg = quantile(angles, 0.5);
   q.max_radius_edge_ratio = *std::max_element(ratios.begin(), ratios.end());
   q.median_radius_edge_ratio = quantile(ratios, 0.5);

@@ -35,6 +35,7 @@ struct QualityStats {
   double max_dihedral_deg = 0;
   double p1_dihedral_deg = 0;       ///< 1st percentile of all 6 #K dihedral angles
   double median_dihedral_deg = 0;
+  double median_tet_min_dihedral_deg = 0;  ///< median over tets of each tet's smallest angle
   double max_radius_edge_ratio = 0;  ///< circumradius / shortest edge (regular tet: 0.612)
   double median_radius_edge_ratio = 0;
   std::vector<std::int64_t> dihedral_histogram;  ///< 180 bins of one degree: [k, k + 1)
