@@ -131,7 +131,8 @@ try:
         facts["panel_is_ours"] = isinstance(tp, TaskPanelMeshBspTet)
         state["panel"] = tp
         t0 = time.monotonic()
-        facts["apply_started"] = tp.start_meshing()
+        tp.bt_mesh.click()  # as a user does
+        facts["apply_started"] = tp.job is not None
         facts["gui_responsive_while_meshing"] = tp.running  # start returned before the end
         facts["panel_finished"] = tp.wait(120)
         facts["panel_seconds"] = time.monotonic() - t0
@@ -182,13 +183,18 @@ try:
             buttons = [b for box in top.findChildren(QtGui.QDialogButtonBox)
                        for b in box.buttons() if b.isVisible()]
             facts["dialog_buttons"] = sorted(b.text().replace("&", "") for b in buttons)
+            facts["panel_buttons"] = sorted(b.text() for b in tp.form.findChildren(
+                QtGui.QPushButton) if b.isVisible())
             facts["dialog_buttons_inside"] = all(
                 b.mapTo(top, QtCore.QPoint(b.width(), 0)).x() <= top.width() for b in buttons)
             table = tp.table
             facts["table_fits"] = table.mapTo(tp.form, QtCore.QPoint(table.width(), 0)).x() \
                 <= view.width()
             facts["table_columns_fit"] = table.horizontalHeader().length() <= \
-                table.viewport().width()
+                table.viewport().width() and all(
+                    table.columnWidth(c) >= max(table.sizeHintForColumn(c),
+                                                table.horizontalHeader().sectionSizeHint(c))
+                    for c in range(table.columnCount()))  # no text elided
         # the spin box keeps what it was given to the full precision
         obj.CharacteristicLengthMax = 10.123456789
         tp.load_parameters()

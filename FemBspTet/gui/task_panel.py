@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Task panel of the BspTet mesher object: parameters, Apply/OK/Cancel, progress, Stop, the stats
-and the comparison at the same size (our mesh, TetGen's, Gmsh's and Netgen's: a column each).
+"""Task panel of the BspTet mesher object: parameters, Mesh and Stop, progress, OK/Cancel, the
+stats and the comparison at the same size (our mesh, TetGen's, Gmsh's and Netgen's: a column each).
 
-* Apply writes the parameters to the object and meshes in a worker process
+* Mesh writes the parameters to the object and meshes in a worker process
   (:class:`FemBspTet.freecad.mesh_worker.MeshJob`): the GUI thread only polls it from a QTimer, so
   FreeCAD never freezes, and a crash of the core cannot take FreeCAD down.
 * Stop (or the dialog's Cancel) kills the worker at once; nothing of that run is kept.
@@ -45,8 +45,9 @@ TABLE_ROWS = (
 #: Columns of the comparison table: (header, mesher of the comparison rows).
 TABLE_MESHERS = (("ours", OURS),) + tuple((peer, peer) for peer in PEERS)
 POLL_INTERVAL_MS = 100
-#: The comparison table's font, relative to the panel's.
-TABLE_FONT_SCALE = 0.8
+#: The comparison table's font size at most (points): small enough for its four columns to fit
+#: FreeCAD's default combo view at a 12-point panel font.
+TABLE_POINT_SIZE = 7.8
 #: Contents margins of the panel's group boxes (left, top, right, bottom), in pixels.
 MARGINS = (4, 6, 4, 4)
 
@@ -148,14 +149,19 @@ class TaskPanelMeshBspTet:
         self.bt_stop.setToolTip("Stop meshing; the previous mesh is kept")
         self.bt_stop.setEnabled(False)
         self.bt_stop.clicked.connect(self.stop_meshing)
-        self.status = QtGui.QLabel("Apply meshes the part.")
+        self.bt_mesh = QtGui.QPushButton("Mesh")
+        self.bt_mesh.setToolTip("Write the parameters and mesh the part (in the background)")
+        self.bt_mesh.clicked.connect(lambda: self.start_meshing())
+        self.status = QtGui.QLabel("Mesh meshes the part.")
         self.status.setWordWrap(True)
-        run_layout.addWidget(self.progress, 0, 0)
+        run_layout.addWidget(self.bt_mesh, 0, 0)
         run_layout.addWidget(self.bt_stop, 0, 1)
-        run_layout.addWidget(self.status, 1, 0, 1, 2)
+        run_layout.addWidget(self.progress, 1, 0, 1, 2)
+        run_layout.addWidget(self.status, 2, 0, 1, 2)
         layout.addWidget(run)
 
         res = QtGui.QGroupBox("Result")
+        res.setFlat(True)  # no frame: the table has its own
         res_layout = QtGui.QVBoxLayout(res)
         res_layout.setContentsMargins(0, MARGINS[1], 0, 0)  # the table's own frame is enough
         self.stats = QtGui.QLabel("")
@@ -174,7 +180,7 @@ class TaskPanelMeshBspTet:
             self.table.fontMetrics().height() + 6)
         self.table.horizontalHeader().setMinimumSectionSize(8)
         small = self.table.font()
-        small.setPointSizeF(small.pointSizeF() * TABLE_FONT_SCALE)
+        small.setPointSizeF(min(small.pointSizeF(), TABLE_POINT_SIZE))
         for part in (self.table, self.table.horizontalHeader(), self.table.verticalHeader()):
             part.setFont(small)
         res_layout.addWidget(self.stats)
@@ -184,21 +190,11 @@ class TaskPanelMeshBspTet:
         return form
 
     def _fit_table(self):
-        """Each column as wide as its widest text, the table as tall as its rows: all of it
-        visible without scrolling, in little width."""
+        """Each column as wide as its widest text (Qt's own measure, cell margins included),
+        the table as large as its cells: all of it visible without scrolling."""
         t = self.table
-        metrics = t.fontMetrics()
-        pad = metrics.averageCharWidth() // 2 + 2
-
-        def width(text):
-            return metrics.boundingRect(text).width() + pad
-
-        for c in range(t.columnCount()):
-            texts = [t.horizontalHeaderItem(c).text()] + \
-                [t.item(r, c).text() for r in range(t.rowCount()) if t.item(r, c) is not None]
-            t.setColumnWidth(c, max(width(x) for x in texts))
-        t.verticalHeader().setFixedWidth(max(
-            width(t.verticalHeaderItem(r).text()) for r in range(t.rowCount())))
+        t.resizeColumnsToContents()
+        t.verticalHeader().setFixedWidth(t.verticalHeader().sizeHint().width())
         frame = 2 * t.frameWidth()
         t.setFixedHeight(t.horizontalHeader().height() + frame + sum(
             t.rowHeight(r) for r in range(t.rowCount())))
@@ -230,14 +226,10 @@ class TaskPanelMeshBspTet:
     def getStandardButtons(self):
         from PySide import QtGui
 
+        # No Apply: the panel's own Mesh button does it, and OK, Cancel and Apply side by side
+        # are wider than FreeCAD's default combo view.
         b = QtGui.QDialogButtonBox
-        return int(b.Ok) | int(b.Apply) | int(b.Cancel)
-
-    def clicked(self, button):
-        from PySide import QtGui
-
-        if button == QtGui.QDialogButtonBox.Apply:
-            self.start_meshing()
+        return int(b.Ok) | int(b.Cancel)
 
     def accept(self):
         import FreeCAD
@@ -293,10 +285,14 @@ class TaskPanelMeshBspTet:
         self.progress.setRange(0, 0)
         self.progress.setTextVisible(True)
         self.status.setText("Starting the meshing worker...")
-        self.bt_stop.setEnabled(True)
+        self._show_running(True)
         self._timer.start()
         FreeCAD.Console.PrintMessage("FemBspTet: meshing %s\n" % self.obj.Label)
         return True
+
+    def _show_running(self, running):
+        self.bt_stop.setEnabled(running)
+        self.bt_mesh.setEnabled(not running)
 
     def stop_meshing(self):
         """Kill the running worker; the previous mesh stays."""
@@ -307,7 +303,7 @@ class TaskPanelMeshBspTet:
         self._timer.stop()
         self.job.cancel()
         self.job = None
-        self.bt_stop.setEnabled(False)
+        self._show_running(False)
         self.progress.setRange(0, 1000)
         self.progress.setValue(0)
         self.progress.setTextVisible(False)
@@ -331,7 +327,7 @@ class TaskPanelMeshBspTet:
             return
         self._timer.stop()
         job, self.job = self.job, None
-        self.bt_stop.setEnabled(False)
+        self._show_running(False)
         self.progress.setRange(0, 1000)
         self.progress.setTextVisible(False)
         try:
