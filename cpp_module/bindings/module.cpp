@@ -12,6 +12,7 @@
 #include "bsptet/cad/cad_distance.h"
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/errors.h"
+#include "bsptet/fem/fem_faces.h"
 #include "bsptet/fem/fem_mesh.h"
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesher.h"
@@ -147,9 +148,13 @@ MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effor
 // The FEM pipeline (fem/fem_mesh.h) on a model read by `read`, with the options as arguments.
 // Returns (points (n, 3), tets (k, 4 or 10), tet_solid (k,), triangles (f, 3 or 6),
 // triangle_face (f,), stats dict).
-py::tuple mesh_cad(const std::function<cad::CadModel()>& read, double size, double min_size, int order,
-                   double grading, double points_per_circle, const std::map<int, double>& size_by_face,
-                   int optimize_rounds, int face_rounds, const py::object& progress, const py::object& cancel) {
+py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension, double size,
+                   double min_size, int order, double grading, double points_per_circle,
+                   const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
+                   const py::object& progress, const py::object& cancel) {
+  if (dimension != 2 && dimension != 3)
+    throw InputError(ErrorCode::kBadArgument, "fem", -1,
+                     "option dimension must be 2 (the faces) or 3 (the solids), got " + std::to_string(dimension));
   fem::FemOptions o;
   o.size = size;
   o.min_size = min_size;
@@ -162,8 +167,11 @@ py::tuple mesh_cad(const std::function<cad::CadModel()>& read, double size, doub
   fem::FemMesh fm;
   fem::FemStats st;
   run_without_gil(o, progress, cancel, [&]() {
-    const cad::CadModel model = read();
-    fm = fem::mesh_cad_model(model, o, &st);
+    if (dimension == 3) {
+      fm = fem::mesh_cad_model(read(cad::CadContent::kSolids), o, &st);
+    } else {
+      fm = fem::mesh_cad_faces(read(cad::CadContent::kFaces), o, &st);
+    }
   });
   py::array_t<std::int64_t> tet_solid(static_cast<py::ssize_t>(fm.tet_solid.size()));
   std::copy(fm.tet_solid.begin(), fm.tet_solid.end(), tet_solid.mutable_data());
@@ -178,6 +186,7 @@ py::tuple mesh_cad(const std::function<cad::CadModel()>& read, double size, doub
   d["size"] = st.size;
   d["min_size"] = st.min_size;
   d["order"] = order;
+  d["dimension"] = dimension;
   d["surface_nodes"] = st.surface_nodes;
   d["surface_triangles"] = st.surface_triangles;
   d["shared_faces"] = st.shared_faces;
@@ -558,8 +567,9 @@ PYBIND11_MODULE(_bsptet, m) {
 
   // ---- The FEM pipeline from CAD (fem/fem_mesh.h). ----
   const char* mesh_cad_doc =
-      "Meshes every solid of a CAD model: surface at the size field, exact core, refinement with new "
-      "surface points and tet10 mid-nodes on the CAD, one mesh of all solids (see fem/fem_mesh.h). "
+      "dimension 3: meshes every solid of a CAD model: surface at the size field, exact core, refinement "
+      "with new surface points and tet10 mid-nodes on the CAD, one mesh of all solids (fem/fem_mesh.h); "
+      "dimension 2: every CAD face as triangles (tria6 mid-nodes on the CAD), no tets (fem/fem_faces.h). "
       "size / min_size: CharacteristicLengthMax / Min in model units (0: automatic, diagonal / 20 and "
       "size / 50); order 1 (tet4) or 2 (tet10); grading per unit length; points_per_circle for curved "
       "faces (0: off); size_by_face {0-based face: size}. Returns (points (n, 3), tets (k, 4 or 10), "
@@ -568,13 +578,14 @@ PYBIND11_MODULE(_bsptet, m) {
   const fem::FemOptions fem_defaults;
   m.def(
       "mesh_cad_file",
-      [](const std::string& path, double size, double min_size, int order, double grading,
+      [](const std::string& path, int dimension, double size, double min_size, int order, double grading,
          double points_per_circle, const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
          py::object progress, py::object cancel) {
-        return mesh_cad([&] { return cad::read_cad_file(path); }, size, min_size, order, grading, points_per_circle,
-                        size_by_face, optimize_rounds, face_rounds, progress, cancel);
+        return mesh_cad([&](cad::CadContent content) { return cad::read_cad_file(path, content); }, dimension,
+                        size, min_size, order, grading, points_per_circle, size_by_face, optimize_rounds,
+                        face_rounds, progress, cancel);
       },
-      py::arg("path"), py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
+      py::arg("path"), py::arg("dimension") = 3, py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
       py::arg("order") = fem_defaults.order, py::arg("grading") = fem_defaults.grading,
       py::arg("points_per_circle") = fem_defaults.points_per_circle,
       py::arg("size_by_face") = std::map<int, double>{}, py::arg("optimize_rounds") = fem_defaults.optimize_rounds,
@@ -583,13 +594,14 @@ PYBIND11_MODULE(_bsptet, m) {
       (std::string("A STEP, BREP or IGES file (by extension). ") + mesh_cad_doc).c_str());
   m.def(
       "mesh_cad_brep",
-      [](const std::string& brep, double size, double min_size, int order, double grading,
+      [](const std::string& brep, int dimension, double size, double min_size, int order, double grading,
          double points_per_circle, const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
          py::object progress, py::object cancel) {
-        return mesh_cad([&] { return cad::read_brep_string(brep); }, size, min_size, order, grading,
-                        points_per_circle, size_by_face, optimize_rounds, face_rounds, progress, cancel);
+        return mesh_cad([&](cad::CadContent content) { return cad::read_brep_string(brep, "BREP string", content); },
+                        dimension, size, min_size, order, grading, points_per_circle, size_by_face,
+                        optimize_rounds, face_rounds, progress, cancel);
       },
-      py::arg("brep"), py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
+      py::arg("brep"), py::arg("dimension") = 3, py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
       py::arg("order") = fem_defaults.order, py::arg("grading") = fem_defaults.grading,
       py::arg("points_per_circle") = fem_defaults.points_per_circle,
       py::arg("size_by_face") = std::map<int, double>{}, py::arg("optimize_rounds") = fem_defaults.optimize_rounds,

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The FEM pipeline from CAD (fem/fem_mesh.h) and the CAD projection hook (cad/cad_projection.h).
+// The FEM pipeline from CAD (fem/fem_mesh.h, fem/fem_faces.h) and the CAD projection hook
+// (cad/cad_projection.h).
 // Every mesh is held to invariants: checked exactly (positive tets, conforming faces, closed
 // boundary, consistent mid-nodes), every 10-node tet certified valid, the boundary equal to the
 // triangles of the faces no two solids share, every CAD face and solid present, per-solid volumes
@@ -35,6 +36,7 @@
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/cad/cad_projection.h"
 #include "bsptet/errors.h"
+#include "bsptet/fem/fem_faces.h"
 #include "bsptet/fem/fem_mesh.h"
 #include "bsptet/mesh_check.h"
 #include "bsptet/mesher.h"
@@ -433,4 +435,99 @@ TEST(CadPipeline, BottleTet10MidNodesOnTheirFaces) {
     if (d > tolerance) ++off_face;
   }
   EXPECT_EQ(off_face, 0) << "largest distance " << worst;
+}
+
+// ---- 2D: the CAD faces as triangles (fem/fem_faces.h). ----
+
+/// A cylinder's side face alone (no solid): a surface mesh whose every node, tria6 mid-nodes
+/// included, lies on the cylinder (radius 5) within the CAD's precision, whose triangles cover
+/// the face's area, all turned the way the face is, and no curved triangle needed straightening.
+TEST(CadFaces, CylinderSideFaceTria6OnTheSurface) {
+  const TopoDS_Shape cylinder = BRepPrimAPI_MakeCylinder(5, 10).Shape();
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(cylinder, TopAbs_FACE, faces);
+  const TopoDS_Shape side = faces(1);  // the lateral face
+  EXPECT_THROW(cad::make_cad_model(side, "side"), InputError);  // no solid: no volume mesh
+  const cad::CadModel model = cad::make_cad_model(side, "side", cad::CadContent::kFaces);
+  for (int order : {1, 2}) {
+    fem::FemOptions o;
+    o.size = 2;
+    o.order = order;
+    fem::FemStats st;
+    const fem::FemMesh m = fem::mesh_cad_faces(model, o, &st);
+    ASSERT_EQ(m.nodes_per_triangle, order == 1 ? 3 : 6);
+    EXPECT_EQ(m.mesh.num_tets(), 0);
+    ASSERT_GT(m.num_triangles(), 50);
+    EXPECT_EQ(st.midnodes_straightened, 0);
+    auto P = [&](Index v) { return Vec3{m.mesh.xyz[3 * v], m.mesh.xyz[3 * v + 1], m.mesh.xyz[3 * v + 2]}; };
+    double area = 0;
+    for (Index t = 0; t < m.num_triangles(); ++t) {
+      const Index* n = &m.tri[static_cast<std::size_t>(m.nodes_per_triangle * t)];
+      EXPECT_EQ(m.tri_face[static_cast<std::size_t>(t)], 0);
+      for (int k = 0; k < m.nodes_per_triangle; ++k) {
+        const Vec3 p = P(n[k]);
+        EXPECT_NEAR(std::hypot(p.x, p.y), 5.0, 1e-9) << "node " << n[k];
+        EXPECT_GE(p.z, -1e-12);
+        EXPECT_LE(p.z, 10 + 1e-12);
+      }
+      const Vec3 a = P(n[0]), b = P(n[1]), c = P(n[2]);
+      const Vec3 u{b.x - a.x, b.y - a.y, b.z - a.z}, v{c.x - a.x, c.y - a.y, c.z - a.z};
+      const Vec3 normal{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+      area += 0.5 * norm(normal);
+      // the cylinder's face normal points away from the axis: every triangle agrees
+      const Vec3 centre{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, 0};
+      EXPECT_GT(normal.x * centre.x + normal.y * centre.y, 0) << "triangle " << t;
+    }
+    // chords inside the circle: the area is a little below 2 pi r h, never above
+    EXPECT_LT(area, 2 * M_PI * 5 * 10);
+    EXPECT_GT(area, 0.97 * 2 * M_PI * 5 * 10);
+  }
+}
+
+/// An open box (five faces of a cube, a Shell with a free border): the mesh is conforming along
+/// the CAD edges the faces share (every triangle edge is used twice, except along the free
+/// border, used once), and the free border's mid-nodes lie on the square z = 10.
+TEST(CadFaces, OpenBoxConformsAndKeepsItsFreeBorder) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 10, 10, 10).Shape();
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(box, TopAbs_FACE, faces);
+  BRep_Builder builder;
+  TopoDS_Compound five;
+  builder.MakeCompound(five);
+  int top = -1;
+  for (int f = 1; f <= faces.Extent(); ++f) {
+    GProp_GProps props;
+    BRepGProp::SurfaceProperties(faces(f), props);
+    if (props.CentreOfMass().Z() > 9.9) {
+      top = f;
+      continue;
+    }
+    builder.Add(five, faces(f));
+  }
+  ASSERT_GT(top, 0);
+  const cad::CadModel model = cad::make_cad_model(five, "open box", cad::CadContent::kFaces);
+  fem::FemOptions o;
+  o.size = 2.5;
+  o.order = 2;
+  const fem::FemMesh m = fem::mesh_cad_faces(model, o);
+  std::map<std::array<Index, 2>, std::vector<Index>> uses;  // corner pair -> mid-nodes met
+  for (Index t = 0; t < m.num_triangles(); ++t) {
+    const Index* n = &m.tri[static_cast<std::size_t>(6 * t)];
+    for (int k = 0; k < 3; ++k)
+      uses[{std::min(n[k], n[(k + 1) % 3]), std::max(n[k], n[(k + 1) % 3])}].push_back(n[3 + k]);
+  }
+  int border = 0;
+  for (const auto& [edge, mids] : uses) {
+    ASSERT_LE(mids.size(), 2u);
+    if (mids.size() == 2) {
+      EXPECT_EQ(mids[0], mids[1]);  // one mid-node per edge
+      continue;
+    }
+    ++border;
+    const double z0 = m.mesh.xyz[3 * edge[0] + 2], z1 = m.mesh.xyz[3 * edge[1] + 2];
+    EXPECT_EQ(z0, 10);
+    EXPECT_EQ(z1, 10);
+    EXPECT_NEAR(m.mesh.xyz[3 * mids[0] + 2], 10, 1e-12);
+  }
+  EXPECT_GE(border, 16);  // the square of side 10 at size 2.5: at least 4 segments a side
 }

@@ -16,6 +16,7 @@
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Vertex.hxx>
 
 #include "bsptet/errors.h"
 
@@ -69,7 +70,13 @@ double CadModel::diagonal() const {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source) {
+std::array<int, 2> CadModel::edge_ends(int e) const {
+  TopoDS_Vertex v0, v1;
+  TopExp::Vertices(TopoDS::Edge(edges(e + 1).Oriented(TopAbs_FORWARD)), v0, v1);
+  return {vertex_index(v0), vertex_index(v1)};
+}
+
+CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source, CadContent content) {
   if (shape.IsNull()) fail(source, "holds no shape");
   CadModel model;
   model.shape = shape;
@@ -78,6 +85,10 @@ CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source) {
   TopExp::MapShapes(shape, TopAbs_FACE, model.faces);
   TopExp::MapShapes(shape, TopAbs_EDGE, model.edges);
   TopExp::MapShapes(shape, TopAbs_VERTEX, model.vertices);
+  if (content == CadContent::kFaces) {
+    if (model.faces.Extent() == 0) fail(source, "holds no face: a surface mesh needs a Face or a Shell");
+    return model;
+  }
   if (model.solids.Extent() == 0) {
     TopTools_IndexedMapOfShape shells;
     TopExp::MapShapes(shape, TopAbs_SHELL, shells);
@@ -100,7 +111,7 @@ CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source) {
   return model;
 }
 
-CadModel read_cad_file(const std::string& path) {
+CadModel read_cad_file(const std::string& path, CadContent content) {
   const std::string ext = lower_extension(path);
   TopoDS_Shape shape;
   try {
@@ -116,10 +127,10 @@ CadModel read_cad_file(const std::string& path) {
   } catch (const Standard_Failure& e) {
     fail(path, std::string("OpenCASCADE could not read it: ") + (e.GetMessageString() ? e.GetMessageString() : "?"));
   }
-  return make_cad_model(shape, path);
+  return make_cad_model(shape, path, content);
 }
 
-CadModel read_brep_string(const std::string& brep, const std::string& source) {
+CadModel read_brep_string(const std::string& brep, const std::string& source, CadContent content) {
   TopoDS_Shape shape;
   BRep_Builder builder;
   std::istringstream in(brep);
@@ -128,7 +139,7 @@ CadModel read_brep_string(const std::string& brep, const std::string& source) {
   } catch (const Standard_Failure& e) {
     fail(source, std::string("not a BREP shape: ") + (e.GetMessageString() ? e.GetMessageString() : "?"));
   }
-  return make_cad_model(shape, source);
+  return make_cad_model(shape, source, content);
 }
 
 }  // namespace bsptet::cad

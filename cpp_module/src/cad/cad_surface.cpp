@@ -395,6 +395,15 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
     progress("faces", double(f + 1) / n_faces);
   }
 
+  // ---- Every face once, as the shape orients it. ----
+  for (int f = 0; f < n_faces; ++f) {
+    const bool reversed = model.faces(f + 1).Orientation() == TopAbs_REVERSED;
+    for (const auto& t : face_tris[f]) {
+      out.face_tri.insert(out.face_tri.end(), {t[0], reversed ? t[2] : t[1], reversed ? t[1] : t[2]});
+      out.face_tag.push_back(f);
+    }
+  }
+
   // ---- Solids: their faces, oriented outward. ----
   for (int s = 1; s <= model.num_solids(); ++s) {
     std::vector<Index> tri;

@@ -30,7 +30,19 @@ double seconds_since(Clock::time_point start) {
 /// Tet edges in the mid-node order of types.h: m12 m23 m31 m14 m24 m34.
 constexpr int kTetEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 
-void check_options(const FemOptions& o) {
+/// Rethrows a stage's error with the solid named first (same type, code and index).
+[[noreturn]] void rethrow_for_solid(const Error& e, const cad::CadModel& model, int solid) {
+  const std::string what = model.source + ": Solid" + std::to_string(solid + 1) + ": " + e.what();
+  if (dynamic_cast<const InputError*>(&e)) throw InputError(e.code(), e.stage(), e.index(), what);
+  throw MeshingError(e.code(), e.stage(), e.index(), what);
+}
+
+Vec3 midpoint(const Vec3& a, const Vec3& b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)}; }
+bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+}  // namespace
+
+void check_fem_options(const FemOptions& o) {
   auto bad = [](const std::string& what) { throw InputError(ErrorCode::kBadArgument, "fem", -1, what); };
   auto non_negative = [&](double value, const char* name) {
     if (!std::isfinite(value) || value < 0) {
@@ -55,21 +67,21 @@ void check_options(const FemOptions& o) {
   }
 }
 
-/// Rethrows a stage's error with the solid named first (same type, code and index).
-[[noreturn]] void rethrow_for_solid(const Error& e, const cad::CadModel& model, int solid) {
-  const std::string what = model.source + ": Solid" + std::to_string(solid + 1) + ": " + e.what();
-  if (dynamic_cast<const InputError*>(&e)) throw InputError(e.code(), e.stage(), e.index(), what);
-  throw MeshingError(e.code(), e.stage(), e.index(), what);
+cad::CadSurfaceOptions cad_surface_options(const FemOptions& options) {
+  cad::CadSurfaceOptions so;
+  so.size.size = options.size;
+  so.size.min_size = options.min_size;
+  so.size.points_per_circle = options.points_per_circle;
+  so.size.grading = options.grading;
+  so.size.size_by_face = options.size_by_face;
+  so.face_rounds = options.face_rounds;
+  so.cancelled = options.cancelled;
+  return so;
 }
-
-Vec3 midpoint(const Vec3& a, const Vec3& b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)}; }
-bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-
-}  // namespace
 
 FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats) {
   const auto start = Clock::now();
-  check_options(options);
+  check_fem_options(options);
   FemStats st;
   st.solids = model.num_solids();
   st.faces = model.num_faces();
@@ -83,15 +95,8 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   };
 
   // ---- 1. Surface. ----
-  cad::CadSurfaceOptions so;
-  so.size.size = options.size;
-  so.size.min_size = options.min_size;
-  so.size.points_per_circle = options.points_per_circle;
-  so.size.grading = options.grading;
-  so.size.size_by_face = options.size_by_face;
-  so.face_rounds = options.face_rounds;
+  cad::CadSurfaceOptions so = cad_surface_options(options);
   so.progress = [&](const std::string& stage, double f) { report("surface: " + stage, 0.1 * f); };
-  so.cancelled = options.cancelled;
   cad::CadSurfaceStats sst;
   auto t = Clock::now();
   const cad::CadSurface surface = cad::mesh_cad_surface(model, so, &sst);

@@ -12,6 +12,7 @@
 // This layer is the only one that links OpenCASCADE; nothing below it (mesh, core, refine) does.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -35,18 +36,27 @@ struct CadModel {
   int vertex_index(const TopoDS_Shape& v) const { return vertices.FindIndex(v) - 1; }
   /// Axis-aligned bounding box diagonal of the shape (model units).
   double diagonal() const;
+  /// 0-based indices of the vertices at the two ends of edge `e` (0-based; equal for a closed
+  /// edge).
+  std::array<int, 2> edge_ends(int e) const;
 };
 
+/// What a model must hold: solids (a volume mesh; every face bounds a solid), or faces (a surface
+/// mesh of every face: a Face, a Shell, or the faces of solids).
+enum class CadContent { kSolids, kFaces };
+
 /// Reads a STEP, BREP or IGES file (chosen by extension, case-insensitive). Throws InputError
-/// naming the file when it cannot be read, is empty, or holds no solid (the message says what it
-/// holds instead: shells, faces, ...).
-CadModel read_cad_file(const std::string& path);
+/// naming the file when it cannot be read, is empty, or does not hold what `content` asks (the
+/// message says what it holds instead: shells, faces, ...).
+CadModel read_cad_file(const std::string& path, CadContent content = CadContent::kSolids);
 
 /// Reads a shape in OpenCASCADE's BREP text format (what FreeCAD's Shape.exportBrepToString()
 /// gives). Same errors as read_cad_file.
-CadModel read_brep_string(const std::string& brep, const std::string& source = "BREP string");
+CadModel read_brep_string(const std::string& brep, const std::string& source = "BREP string",
+                          CadContent content = CadContent::kSolids);
 
 /// Numbers an existing shape's topology (no copy of the geometry). Same errors.
-CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source);
+CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source,
+                        CadContent content = CadContent::kSolids);
 
 }  // namespace bsptet::cad

@@ -59,6 +59,11 @@ struct CadSurface {
   /// One closed surface per solid (CAD solid order): triangles in node ids of `xyz`, with tags.
   std::vector<std::vector<Index>> solid_tri;
   std::vector<std::vector<std::int32_t>> solid_tag;
+  /// Every CAD face once (face order), counter-clockwise about the face's normal as the shape
+  /// orients the face (a shell's faces agree where the shell is consistently oriented): triangles
+  /// in node ids of `xyz`, and the face of each.
+  std::vector<Index> face_tri;
+  std::vector<std::int32_t> face_tag;
 
   /// Solid s's surface as a SurfaceMesh: only its own nodes, renumbered in increasing node id;
   /// `node_of` (if given) receives each new index's node id.

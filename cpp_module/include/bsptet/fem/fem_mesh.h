@@ -43,6 +43,7 @@
 
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/cad/cad_projection.h"
+#include "bsptet/cad/cad_surface.h"
 #include "bsptet/types.h"
 
 namespace bsptet::fem {
@@ -155,5 +156,11 @@ CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh
 /// bad options and naming the CAD face, edge or solid for a model that cannot be meshed as given;
 /// MeshingError when a stage fails on valid input (code kCancelled when cancelled).
 FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats = nullptr);
+
+/// Throws InputError naming the option when `options` holds a value out of range.
+void check_fem_options(const FemOptions& options);
+
+/// The CAD layer's surface options for `options` (size field, face rounds, cancel; no progress).
+cad::CadSurfaceOptions cad_surface_options(const FemOptions& options);
 
 }  // namespace bsptet::fem
