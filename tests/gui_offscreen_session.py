@@ -232,6 +232,8 @@ try:
         doc.recompute()
         before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount)
         set_source(obj, shell)
+        obj.ElementDimension = "3D"  # an open shell has no volume to mesh
+        tp.load_parameters()
         tp.sb_max.setValue(0.0)
         tp.start_meshing()
         tp.wait(120)
@@ -240,6 +242,8 @@ try:
         facts["mesh_kept_after_failure"] = before == (obj.FemMesh.NodeCount,
                                                       obj.FemMesh.VolumeCount)
         set_source(obj, block)
+        obj.ElementDimension = "From Shape"
+        tp.load_parameters()
         doc.removeObject("OpenShell")
 
     @step("dialog buttons")

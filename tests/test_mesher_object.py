@@ -163,6 +163,77 @@ def test_comparison_row_of_a_missing_peer(monkeypatch, tmp_path):
         "installed"
 
 
+# ------------------------------------------------------------------------------- 2D
+
+@pytest.mark.parametrize("order", ["1st", "2nd"])
+def test_2d_mesh_of_a_face_and_a_shell(doc, fc, order):
+    """A Face (a plate with a hole) and an open Shell mesh as triangles ("From Shape": no solid,
+    so 2D): FemMesh faces only (tria3 / tria6), a face group and a node group per CAD face, every
+    node on its CAD face (getNodesByFace finds them all), the plate's area covered."""
+    freecad, Part, _ = fc
+    plate = Part.makePlane(40, 20).cut(Part.makeCylinder(5, 1, freecad.Vector(20, 10, -0.5)))
+    shell = Part.Shell(Part.makeBox(10, 10, 10).Faces[:5])
+    for shape, name in ((plate.Faces[0], "Plate"), (shell, "OpenBox")):
+        part = add_part(doc, fc, shape, name)
+        obj = FemBspTet.make_mesher(doc, part, ElementOrder=order, CharacteristicLengthMax=2.5)
+        assert obj.ElementDimension == "From Shape" and obj.FaceGroups is True
+        result = FemBspTet.run_mesher(obj)
+        fem = obj.FemMesh
+        k = 3 if order == "1st" else 6
+        assert fem.VolumeCount == 0 and obj.Tetrahedra == 0
+        assert fem.FaceCount == fem.TriangleCount == obj.Triangles == len(result.boundary_faces)
+        assert fem.NodeCount == obj.Nodes == len(result.mesh.points)
+        assert {len(fem.getElementNodes(e)) for e in fem.Faces} == {k}
+        assert obj.MeshStatus == "meshed: %d nodes, %d tria%d" % (obj.Nodes, obj.Triangles, k)
+        assert fem.GroupCount == 2 * len(shape.Faces)
+        assert_every_face_node_found(result, fem, part.Shape)
+        # mid-nodes (tria6) and corners lie on the CAD
+        pts = result.mesh.points
+        for i in range(0, len(pts), max(1, len(pts) // 60)):
+            assert shape.distToShape(Part.Vertex(freecad.Vector(*pts[i])))[0] < 1e-9
+        if name == "Plate":
+            tri = result.boundary_faces
+            a, b, c = (pts[tri[:, j]] for j in range(3))
+            area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
+            # the hole's chords cut off a little of it: a little more than the CAD area
+            assert shape.Area < area < 1.01 * shape.Area
+    # a solid asked for 2D: its faces as triangles, no tets
+    obj = FemBspTet.make_mesher(doc, add_part(doc, fc, block_with_hole(fc), "Block"),
+                                ElementDimension="2D", ElementOrder=order,
+                                CompareWithPeers=False)
+    FemBspTet.run_mesher(obj)
+    assert obj.FemMesh.VolumeCount == 0 and obj.FemMesh.FaceCount == obj.Triangles > 0
+
+
+def test_2d_mesh_in_the_worker_process_equals_the_in_process_one(fc):
+    """The task panel's worker meshes a Face as the in-process run does (same BREP text)."""
+    from FemBspTet.freecad.mesh_worker import MeshJob
+
+    freecad, Part, _ = fc
+    face = Part.makePlane(40, 20).cut(Part.makeCylinder(5, 1, freecad.Vector(20, 10, -0.5)))
+    face = face.Faces[0]
+    params = mp.MeshParameters(max_size=3.0, order=2, dimension=2)
+    job = MeshJob(face, params, python="/usr/bin/python3")
+    job.start()
+    assert job.wait(120)
+    worker = job.result()
+    here = mp.mesh_cad_shape(face, params)
+    assert worker.mesh.tets.shape == (0, 4) and len(worker.boundary_faces) > 0
+    assert np.array_equal(worker.mesh.points, here.mesh.points)
+    assert np.array_equal(worker.boundary_faces, here.boundary_faces)
+    assert np.array_equal(worker.boundary_midnodes, here.boundary_midnodes)
+    assert worker.boundary_midnodes.shape == (len(worker.boundary_faces), 3)
+
+
+def test_a_face_asked_for_3d_says_what_to_do(doc, fc):
+    freecad, Part, _ = fc
+    part = add_part(doc, fc, Part.makePlane(10, 10), "Plane")
+    obj = FemBspTet.make_mesher(doc, part, ElementDimension="3D")
+    with pytest.raises(InputError, match="holds no solid"):
+        FemBspTet.run_mesher(obj)
+    assert obj.MeshStatus.startswith("failed: ") and obj.FemMesh.NodeCount == 0
+
+
 def assert_ccx_faces_are_the_boundary_faces(result, fem, shape, k):
     """FreeCAD's getccxVolumesByFace (what its CalculiX writer loads) gives, for CAD face k,
     exactly our boundary triangles tagged k: one (volume, CalculiX face) per triangle, each face
@@ -274,7 +345,8 @@ def test_face_groups(doc, fc):
 def test_failure_keeps_the_previous_mesh(doc, fc):
     _, Part, _ = fc
     part = add_part(doc, fc, block_with_hole(fc))
-    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=False)
+    obj = FemBspTet.make_mesher(doc, part, ElementOrder="1st", CompareWithPeers=False,
+                                ElementDimension="3D")  # an open shell cannot be 3D
     FemBspTet.run_mesher(obj)
     before = (obj.FemMesh.NodeCount, obj.FemMesh.VolumeCount, obj.Nodes)
     shell = add_part(doc, fc, Part.Shell(Part.makeBox(1, 1, 1).Faces[:5]), "OpenShell")

@@ -175,3 +175,60 @@ def mesh_cad_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=N
 
     return _run(lambda **kw: native().mesh_cad_brep(brep, **kw), source, size, min_size, order,
                 progress, cancel, size_by_face)
+
+
+@dataclasses.dataclass
+class CadFacesResult:
+    """A 2D mesh of CAD faces (:func:`mesh_cad_faces_brep`)."""
+
+    points: np.ndarray
+    #: (k, 3) tria3 or (k, 6) tria6 (n1 n2 n3 m12 m23 m31), each face's triangles as the shape
+    #: orients the face
+    triangles: np.ndarray
+    face_tags: np.ndarray  #: (k,) 0-based CAD face of each triangle
+    stats: dict
+    groups: MeshGroups = None
+
+
+def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
+                        size_by_face=None, source="BREP string"):
+    """Every CAD face of a shape in BREP text (a Face, a Shell, or the faces of solids) as
+    triangles at the size field, tria6 mid-nodes on the CAD (``cpp_module/include/bsptet/fem/
+    fem_faces.h``): shell and plane analyses. Raises InputError (no face, bad option) or
+    MeshingError."""
+    if order not in (1, 2):
+        raise InputError(f"order must be 1 or 2, got {order}", where=source)
+    with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
+                             source=""), "FEM surface mesh"):
+        points, _tets, _solid, tri, tri_face, stats = native().mesh_cad_brep(
+            brep, dimension=2, size=float(size or 0.0), min_size=float(min_size or 0.0),
+            order=int(order), size_by_face={int(k): float(v) for k, v in
+                                            (size_by_face or {}).items()},
+            progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
+            cancel=cancel)
+    points = np.asarray(points)
+    tri = np.asarray(tri, dtype=np.int64)
+    tri_face = np.asarray(tri_face, dtype=np.int64)
+    stats = dict(stats)
+    angles = triangle_min_angles(points, tri[:, :3])
+    stats.update(triangles=int(len(tri)), points=int(len(points)),
+                 min_triangle_angle_deg=float(angles.min()) if len(angles) else 0.0,
+                 median_triangle_min_angle_deg=float(np.median(angles)) if len(angles) else 0.0)
+    faces = max(int(stats["faces"]), int(tri_face.max()) + 1 if len(tri_face) else 0)
+    groups = MeshGroups(face_triangles=tri, face_tags=tri_face,
+                        face_names=MeshGroups.default_names("Face", faces))
+    return CadFacesResult(points=points, triangles=tri, face_tags=tri_face, stats=stats,
+                          groups=groups)
+
+
+def triangle_min_angles(points, triangles):
+    """Each triangle's smallest angle (degrees)."""
+    p = np.asarray(points, dtype=float)[np.asarray(triangles)]
+    out = np.full(len(p), 180.0)
+    for k in range(3):
+        u = p[:, (k + 1) % 3] - p[:, k]
+        v = p[:, (k + 2) % 3] - p[:, k]
+        cos = np.einsum("ij,ij->i", u, v) / np.maximum(
+            np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), np.finfo(float).tiny)
+        out = np.minimum(out, np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return out

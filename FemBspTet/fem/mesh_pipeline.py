@@ -27,6 +27,7 @@ Stages:
    part: :mod:`FemBspTet.compare.at_size`, handed in by the FreeCAD layer as ``compare``).
 """
 
+import contextlib
 import dataclasses
 import json
 import math
@@ -37,7 +38,7 @@ import numpy as np
 from ..kernel import core
 from ..kernel.errors import Cancelled, InputError, InternalError, MeshingCancelled
 from ..kernel.mesh_types import MeshGroups, TetMesh
-from .cad_mesh import mesh_cad_brep
+from .cad_mesh import mesh_cad_brep, mesh_cad_faces_brep
 
 #: FreeCAD property name of each MeshParameters field (for messages that name what to change).
 PROPERTY_OF = {
@@ -46,6 +47,7 @@ PROPERTY_OF = {
     "order": "ElementOrder",
     "face_groups": "FaceGroups",
     "compare_peers": "CompareWithPeers",
+    "dimension": "ElementDimension",
 }
 
 #: Parameters of the former tessellation pipeline, by FreeCAD property name: the FEM path meshes
@@ -97,6 +99,8 @@ class MeshParameters:
                     a node group (``BspTet_Face<k>``).
     compare_peers:  also mesh at the same size with TetGen (on our surface), Gmsh and Netgen
                     (on the CAD part, where installed) and report their counts, angles, times.
+    dimension:      3: the solids as tets; 2: every CAD face as triangles (tria3 / tria6, shell
+                    and plane analyses); 0: from the shape (3 if it holds a solid, else 2).
     """
 
     max_size: float = 0.0
@@ -104,6 +108,7 @@ class MeshParameters:
     order: int = 2
     face_groups: bool = True
     compare_peers: bool = False
+    dimension: int = 0
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -112,6 +117,9 @@ class MeshParameters:
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise InputError("%s must be a finite number >= 0 (0 = automatic), got %r"
                                  % (PROPERTY_OF[name], value))
+        if self.dimension not in (0, 2, 3):
+            raise InputError("%s must be From Shape, 2D or 3D (dimension 0, 2 or 3), got %r"
+                             % (PROPERTY_OF["dimension"], self.dimension))
         if self.order not in (1, 2):
             raise InputError("%s must be 1st or 2nd (order 1 or 2), got %r"
                              % (PROPERTY_OF["order"], self.order))
@@ -251,6 +259,7 @@ def mesh_cad_shape(shape, params, progress=None, cancel=None, source="", compare
         raise InputError("expected a Part.Shape, got %s" % type(shape).__name__, where=where)
     if shape.isNull():
         raise InputError("the shape is empty: nothing to mesh", where=where)
+    params = dataclasses.replace(params, dimension=dimension_of(shape, params.dimension))
     return mesh_brep(shape.exportBrepToString(), len(shape.Faces), params, progress=progress,
                      cancel=cancel, source=source, shape=shape, compare=compare)
 
@@ -271,23 +280,15 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
     def fem_progress(stage, fraction):
         report(stage, None if fraction is None else 0.9 * float(fraction))
 
-    try:
-        fem = mesh_cad_brep(brep, size=params.max_size, min_size=params.min_size,
-                            order=params.order, progress=fem_progress, cancel=cancel,
-                            source=source or "shape")
-    except MeshingCancelled:
-        raise
-    except Cancelled:
-        raise MeshingCancelled("cancelled: no mesh was made") from None
-    except InputError as e:
-        # the native reader names its input "BREP string": name the object instead
-        text = str(e)
-        if source and text.startswith(_BREP_SOURCE) and type(e) is InputError:
-            raise InputError(text[len(_BREP_SOURCE):], where=source, code=e.code) from None
-        raise
+    mesher = mesh_cad_faces_brep if params.dimension == 2 else mesh_cad_brep
+    with _named_errors(source):
+        fem = mesher(brep, size=params.max_size, min_size=params.min_size, order=params.order,
+                     progress=fem_progress, cancel=cancel, source=source or "shape")
     if int(fem.stats["faces"]) != int(face_count):
         raise InternalError("%s: the FEM path read %d CAD faces from the BREP, the shape has %d"
                             % (source or "shape", fem.stats["faces"], face_count))
+    if params.dimension == 2:
+        return _faces_result(fem, face_count, source, t_start, report)
     mesh = fem.mesh
     mesh.source = source or mesh.source
     faces = fem.boundary.triangles
@@ -331,6 +332,48 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
 
 #: How the native BREP reader names its input at the start of a message.
 _BREP_SOURCE = "BREP string: "
+
+
+def dimension_of(shape, dimension):
+    """``dimension`` (MeshParameters.dimension) with 0 resolved for ``shape``: 3 when it holds a
+    solid, else 2."""
+    if dimension:
+        return dimension
+    return 3 if len(shape.Solids) else 2
+
+
+@contextlib.contextmanager
+def _named_errors(source):
+    """The native run's errors as the object's: cancelled runs as MeshingCancelled, and messages
+    naming the object where the native reader says "BREP string"."""
+    try:
+        yield
+    except MeshingCancelled:
+        raise
+    except Cancelled:
+        raise MeshingCancelled("cancelled: no mesh was made") from None
+    except InputError as e:
+        text = str(e)
+        if source and text.startswith(_BREP_SOURCE) and type(e) is InputError:
+            raise InputError(text[len(_BREP_SOURCE):], where=source, code=e.code) from None
+        raise
+
+
+def _faces_result(fem, face_count, source, t_start, report):
+    """The MeshResult of a 2D mesh (:class:`~FemBspTet.fem.cad_mesh.CadFacesResult`): no tets;
+    the triangles of every CAD face are its elements."""
+    tri = fem.triangles
+    mesh = TetMesh(fem.points, np.zeros((0, 4), dtype=np.int64), source or "shape")
+    stats = dict(fem.stats)
+    notes = []
+    if tri.shape[1] == 6 and int(stats.get("midnodes_straightened", 0)):
+        notes.append("tria6: %d mid-node(s) were put back on their straight edges, where the "
+                     "curved triangle would have folded" % int(stats["midnodes_straightened"]))
+    stats["seconds_total"] = time.perf_counter() - t_start
+    report("done", 1.0)
+    return MeshResult(mesh, tri[:, :3], fem.face_tags,
+                      tri[:, 3:6] if tri.shape[1] == 6 else np.zeros((0, 3), dtype=np.int64),
+                      ["Face%d" % (k + 1) for k in range(int(face_count))], stats, [], notes)
 
 
 def _validated(params):

@@ -147,19 +147,63 @@ def _add_groups(fem, mesh, groups, prefix):
     """The faces and groups of :func:`tetmesh_to_femmesh`."""
 
     sets = _checked_groups(mesh.source or "mesh", groups, mesh.points, mesh.tets)
-    m = len(mesh.tets)
-    face_ids = np.arange(m + 1, m + 1 + len(sets.tri))
-    add_face = fem.addFace
-    for e, row in zip(face_ids.tolist(), (sets.tri + 1).tolist()):
-        add_face(row, e)
-    for t in sets.faces().tolist():
-        rows = np.flatnonzero(sets.tags == t)
-        name = prefix + sets.face_names[t]
-        fem.addGroupElements(fem.addGroup(name, "Face"), face_ids[rows].tolist())
-        fem.addGroupElements(fem.addGroup(name, "Node"), (np.unique(sets.tri[rows]) + 1).tolist())
+    _add_faces(fem, sets.tri, sets.tags, sets.face_names, len(mesh.tets) + 1, prefix)
     for t in sets.solids().tolist() if groups.tet_solid is not None else ():
         fem.addGroupElements(fem.addGroup(prefix + sets.solid_names[t], "Volume"),
                              (np.flatnonzero(sets.solid == t) + 1).tolist())
+
+
+def _add_faces(fem, tri, tags, face_names, first_id, prefix):
+    """The triangles ``tri`` (0-based nodes; tria3 or tria6) as faces with ids first_id, ...,
+    and per CAD face (``tags``) a "Face" group of them and a "Node" group of their nodes."""
+    face_ids = np.arange(first_id, first_id + len(tri))
+    add_face = fem.addFace
+    for e, row in zip(face_ids.tolist(), (tri + 1).tolist()):
+        add_face(row, e)
+    for t in np.unique(tags).tolist():
+        rows = np.flatnonzero(tags == t)
+        name = prefix + face_names[t]
+        fem.addGroupElements(fem.addGroup(name, "Face"), face_ids[rows].tolist())
+        fem.addGroupElements(fem.addGroup(name, "Node"), (np.unique(tri[rows]) + 1).tolist())
+
+
+def triangles_to_femmesh(points, groups, group_prefix="", source=""):
+    """A 2D ``Fem.FemMesh``: the nodes, the triangles of ``groups.face_triangles`` (tria3, or
+    tria6 n1 n2 n3 m12 m23 m31, SMESH's order) as faces with ids 1, 2, ..., and per CAD face a
+    "Face" group and a "Node" group named ``group_prefix + groups.face_names[tag]``.
+
+    Raises InputError for non-finite coordinates, node indices out of range, or a triangle with
+    a repeated corner (the message names the first one)."""
+
+    import_freecad()
+    import Fem
+
+    where = source or "mesh"
+    points = np.asarray(points, dtype=np.float64)
+    tri = np.asarray(groups.face_triangles, dtype=np.int64)
+    tags = np.asarray(groups.face_tags, dtype=np.int64)
+    if not np.all(np.isfinite(points)):
+        bad = int(np.nonzero(~np.isfinite(points).all(axis=1))[0][0])
+        raise InputError("point %d has a non-finite coordinate %s" % (bad, points[bad]),
+                         where=where)
+    if len(tri) == 0:
+        raise InputError("the mesh has no triangles", where=where)
+    if tri.min() < 0 or tri.max() >= len(points):
+        e = int(np.nonzero((tri < 0).any(axis=1) | (tri >= len(points)).any(axis=1))[0][0])
+        raise InputError("triangle %d refers to node indices %s outside 0..%d"
+                         % (e, tri[e].tolist(), len(points) - 1), where=where)
+    c = tri[:, :3]
+    repeated = (c[:, 0] == c[:, 1]) | (c[:, 1] == c[:, 2]) | (c[:, 0] == c[:, 2])
+    if repeated.any():
+        e = int(np.flatnonzero(repeated)[0])
+        raise InputError("triangle %d has a repeated corner: %s" % (e, c[e].tolist()),
+                         where=where)
+    fem = Fem.FemMesh()
+    add_node = fem.addNode
+    for i, (x, y, z) in enumerate(points.tolist(), start=1):
+        add_node(x, y, z, i)
+    _add_faces(fem, tri, tags, list(groups.face_names), 1, group_prefix)
+    return fem
 
 
 def femmesh_to_tetmesh(femmesh, source=""):

@@ -43,6 +43,10 @@ OBJECT_TYPE = "Fem::FemMeshObjectPython"
 SHAPE_LINK = "Shape"
 PART_LINK = "Part"
 
+#: ElementDimension's choices, as FreeCAD's Gmsh object names them, and MeshParameters.dimension.
+DIMENSIONS = ("From Shape", "2D", "3D")
+DIMENSION_OF = {"From Shape": 0, "2D": 2, "3D": 3}
+
 #: Property groups (FreeCAD's property editor splits camel case: short plain words fit its column).
 PARAMS_GROUP = "Mesh Params"
 RESULTS_GROUP = "Mesh Results"
@@ -57,9 +61,13 @@ PARAMETER_PROPERTIES = (
      "edges get smaller elements (12 per full circle)", 0.0),
     ("App::PropertyLength", "CharacteristicLengthMin", PARAMS_GROUP,
      "Smallest element size (0 = automatic: CharacteristicLengthMax / 50)", 0.0),
+    ("App::PropertyEnumeration", "ElementDimension", PARAMS_GROUP,
+     "3D: the solids as tetrahedra; 2D: every face as triangles (shell and plane analyses); "
+     "From Shape: 3D if the shape holds a solid, else 2D (a Face or a Shell)",
+     (DIMENSIONS, "From Shape")),
     ("App::PropertyEnumeration", "ElementOrder", PARAMS_GROUP,
-     "1st: 4-node tetrahedra; 2nd: 10-node tetrahedra, boundary mid-nodes on the CAD faces",
-     ("1st", "2nd")),
+     "1st: 4-node tetrahedra (3-node triangles in 2D); 2nd: 10-node tetrahedra (6-node "
+     "triangles), boundary mid-nodes on the CAD faces", (("1st", "2nd"), "2nd")),
     ("App::PropertyBool", "FaceGroups", PARAMS_GROUP,
      "Add the boundary triangles as faces (tria6 for 2nd order), and a face group and a node "
      "group per CAD face (BspTet_Face1, ...)", True),
@@ -74,6 +82,7 @@ RESULT_PROPERTIES = (
     ("App::PropertyString", "MeshStatus", "Outcome of the last meshing run"),
     ("App::PropertyInteger", "Nodes", "Nodes of the mesh"),
     ("App::PropertyInteger", "Tetrahedra", "Tetrahedra of the mesh"),
+    ("App::PropertyInteger", "Triangles", "Triangles of a 2D mesh (its elements)"),
     ("App::PropertyInteger", "SteinerPoints",
      "Corner nodes the volume mesher added to the CAD surface mesh's nodes"),
     ("App::PropertyInteger", "BoundarySteinerPoints",
@@ -167,9 +176,9 @@ def add_properties(obj):
             _move_to_group(obj, name, group)
             continue
         obj.addProperty(kind, name, group, tip)
-        if kind == "App::PropertyEnumeration":
-            setattr(obj, name, list(default))
-            setattr(obj, name, default[-1])
+        if kind == "App::PropertyEnumeration":  # default: (choices, chosen)
+            setattr(obj, name, list(default[0]))
+            setattr(obj, name, default[1])
         elif default is not None:
             setattr(obj, name, carried.get(name, default))
     for kind, name, tip in RESULT_PROPERTIES:

@@ -16,11 +16,12 @@ import os
 
 
 from ..compare.at_size import compare_at_size, SizeRow
-from ..fem.mesh_pipeline import (FACE_GROUP_PREFIX, mesh_cad_shape, MeshParameters, PROPERTY_OF,
+from ..fem.mesh_pipeline import (dimension_of, FACE_GROUP_PREFIX, mesh_cad_shape, MeshParameters,
+                                 PROPERTY_OF,
                                  removed_parameter_message, REMOVED_PARAMETERS)
 from ..kernel.errors import InputError
-from .femmesh import tetmesh_to_femmesh, write_femmesh
-from .mesher_object import source_of, source_property
+from .femmesh import tetmesh_to_femmesh, triangles_to_femmesh, write_femmesh
+from .mesher_object import DIMENSION_OF, source_of, source_property
 
 #: Extensions :func:`export_mesh` writes (FreeCAD's own writers, SMESH conventions converted).
 EXPORT_FORMATS = (".inp", ".unv", ".vtk", ".vtu", ".med", ".z88")
@@ -34,6 +35,7 @@ def parameters_from_object(obj):
         order=1 if obj.ElementOrder == "1st" else 2,
         face_groups=bool(obj.FaceGroups),
         compare_peers=bool(obj.CompareWithPeers),
+        dimension=dimension_of(shape_of(obj), DIMENSION_OF[obj.ElementDimension]),
     ).validate()
 
 
@@ -78,6 +80,9 @@ def femmesh_of(result, face_groups):
     """The ``Fem.FemMesh`` of a MeshResult (SMESH conventions; if ``face_groups``, the boundary
     triangles as faces and per CAD face a face group and a node group ``BspTet_Face<k>``)."""
 
+    if len(result.mesh.tets) == 0:  # 2D: the triangles are the elements, grouped per CAD face
+        return triangles_to_femmesh(result.mesh.points, result.groups(),
+                                    group_prefix=FACE_GROUP_PREFIX, source=result.mesh.source)
     return tetmesh_to_femmesh(result.mesh, result.groups() if face_groups else None,
                               group_prefix=FACE_GROUP_PREFIX)
 
@@ -90,6 +95,7 @@ def apply_result(obj, result, femmesh=None):
     obj.FemMesh = fem
     obj.Nodes = int(len(result.mesh.points))
     obj.Tetrahedra = int(len(result.mesh.tets))
+    obj.Triangles = 0 if len(result.mesh.tets) else int(len(result.boundary_faces))
     obj.SteinerPoints = int(st.get("steiner_points", 0))
     obj.BoundarySteinerPoints = int(st.get("boundary_steiner_points", 0))
     obj.MinDihedralAngle = float(st.get("min_dihedral_deg") or 0.0)
@@ -99,8 +105,12 @@ def apply_result(obj, result, femmesh=None):
     obj.MeshNotes = [str(n) for n in result.notes]
     obj.Comparison = [comparison_line(SizeRow.from_dict(r)) for r in result.comparison]
     obj.ComparisonData = json.dumps(result.comparison)
-    obj.MeshStatus = "meshed: %d nodes, %d %s" % (
-        obj.Nodes, obj.Tetrahedra, "tet10" if result.mesh.tets.shape[1] == 10 else "tet4")
+    if obj.Triangles:
+        obj.MeshStatus = "meshed: %d nodes, %d %s" % (
+            obj.Nodes, obj.Triangles, "tria6" if len(result.boundary_midnodes) else "tria3")
+    else:
+        obj.MeshStatus = "meshed: %d nodes, %d %s" % (
+            obj.Nodes, obj.Tetrahedra, "tet10" if result.mesh.tets.shape[1] == 10 else "tet4")
 
 
 def comparison_line(row):

@@ -24,8 +24,8 @@ GMSH_COMMAND = "FEM_MeshGmshFromShape"
 FEM_TOOLBAR_PARAM = "User parameter:BaseApp/Workbench/FemWorkbench/Toolbar/FemBspTet"
 FEM_TOOLBAR_NAME = "BspTet"
 MENU_TEXT = "FEM mesh from shape by BspTet"
-TOOL_TIP = ("Create a FEM mesh from a solid with the exact BSP-assisted tetrahedralizer "
-            "(FemBspTet) and open its task panel")
+TOOL_TIP = ("Create a FEM mesh from a solid (tetrahedra, by the exact BSP-assisted "
+            "tetrahedralizer) or a face or shell (triangles) with FemBspTet and open its task panel")
 
 
 class CommandMeshBspTetFromShape:
@@ -41,7 +41,7 @@ class CommandMeshBspTetFromShape:
         if FreeCAD.ActiveDocument is None:
             return False
         sel = FreeCADGui.Selection.getSelection()
-        return len(sel) == 1 and _has_solid(sel[0])
+        return len(sel) == 1 and _has_faces(sel[0])
 
     def Activated(self):
         import FreeCAD
@@ -50,8 +50,8 @@ class CommandMeshBspTetFromShape:
         sel = FreeCADGui.Selection.getSelection()
         if not self.IsActive():  # reached through a menu entry of ours (FreeCAD 0.20/0.21)
             FreeCAD.Console.PrintWarning(
-                "FemBspTet: select one object with a solid (a Part, Body or imported STEP) "
-                "first, then %s\n" % MENU_TEXT)
+                "FemBspTet: select one object with a solid, a shell or a face (a Part, Body or "
+                "imported STEP) first, then %s\n" % MENU_TEXT)
             return
         part = sel[0]
         doc = FreeCAD.ActiveDocument
@@ -70,10 +70,11 @@ class CommandMeshBspTetFromShape:
         FreeCADGui.Selection.clearSelection()
 
 
-def _has_solid(obj):
+def _has_faces(obj):
+    """A solid (3D mesh) or a Face or Shell (2D mesh)."""
     shape = getattr(obj, "Shape", None)
     try:
-        return shape is not None and not shape.isNull() and len(shape.Solids) > 0
+        return shape is not None and not shape.isNull() and len(shape.Faces) > 0
     except Exception:  # a shape OCCT cannot explore: not a candidate
         return False
 

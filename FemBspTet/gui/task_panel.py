@@ -18,6 +18,7 @@ import time
 
 from ..compare.at_size import OURS, PEERS
 from ..freecad.mesh_worker import MeshJob
+from ..freecad.mesher_object import DIMENSIONS
 from ..freecad.mesher_tools import (apply_result, comparison_rows, parameters_from_object,
                                     record_failure, shape_of)
 from ..kernel.errors import BspTetError, InternalError, MeshingCancelled
@@ -124,6 +125,11 @@ class TaskPanelMeshBspTet:
         self.sb_min = LengthField("Smallest element size; 0 = automatic: the max size / 50")
         grid.addRow("Max size:", self.sb_max.widget)
         grid.addRow("Min size:", self.sb_min.widget)
+        self.cb_dimension = QtGui.QComboBox()
+        self.cb_dimension.addItems(list(DIMENSIONS))
+        self.cb_dimension.setToolTip("3D: tetrahedra of the solids; 2D: triangles of the faces "
+                                     "(shells, plates); From Shape: 3D with a solid, else 2D")
+        grid.addRow("Dimension:", self.cb_dimension)
         self.cb_order = QtGui.QComboBox()
         self.cb_order.addItems(["1st", "2nd"])
         grid.addRow("Order:", self.cb_order)
@@ -207,6 +213,7 @@ class TaskPanelMeshBspTet:
         o = self.obj
         self.sb_max.setValue(o.CharacteristicLengthMax.Value)
         self.sb_min.setValue(o.CharacteristicLengthMin.Value)
+        self.cb_dimension.setCurrentIndex(DIMENSIONS.index(o.ElementDimension))
         self.cb_order.setCurrentIndex(0 if o.ElementOrder == "1st" else 1)
         self.ck_groups.setChecked(bool(o.FaceGroups))
         self.ck_compare.setChecked(bool(o.CompareWithPeers))
@@ -217,6 +224,7 @@ class TaskPanelMeshBspTet:
                             ("CharacteristicLengthMin", self.sb_min)):
             if getattr(o, prop).Value != field.value():
                 setattr(o, prop, field.value())
+        o.ElementDimension = self.cb_dimension.currentText()
         o.ElementOrder = self.cb_order.currentText()
         o.FaceGroups = self.ck_groups.isChecked()
         o.CompareWithPeers = self.ck_compare.isChecked()
@@ -395,12 +403,16 @@ class TaskPanelMeshBspTet:
         if not o.Nodes:
             self.stats.setText("Not meshed yet.")
         else:
-            lines = ["%d nodes, %d tetrahedra (%s order)" % (o.Nodes, o.Tetrahedra,
-                                                              o.ElementOrder),
-                     "smallest dihedral angle %.1f°, median per-tet smallest %.1f°"
-                     % (o.MinDihedralAngle, o.MedianTetMinDihedralAngle),
-                     "%d points added to the surface mesh (%d on the CAD faces); %.1f s"
-                     % (o.SteinerPoints, o.BoundarySteinerPoints, o.MeshingTime)]
+            if o.Triangles:  # 2D
+                lines = ["%d nodes, %d triangles (%s order); %.1f s"
+                         % (o.Nodes, o.Triangles, o.ElementOrder, o.MeshingTime)]
+            else:
+                lines = ["%d nodes, %d tetrahedra (%s order)" % (o.Nodes, o.Tetrahedra,
+                                                                  o.ElementOrder),
+                         "smallest dihedral angle %.1f°, median per-tet smallest %.1f°"
+                         % (o.MinDihedralAngle, o.MedianTetMinDihedralAngle),
+                         "%d points added to the surface mesh (%d on the CAD faces); %.1f s"
+                         % (o.SteinerPoints, o.BoundarySteinerPoints, o.MeshingTime)]
             lines += ["note: %s" % n for n in o.MeshNotes]
             self.stats.setText("\n".join(lines))
             if not self.running:
