@@ -242,6 +242,50 @@ def test_progress_on_an_80_column_terminal_fits_and_never_goes_back(monkeypatch)
     assert any("fembsptet next" in row and "93%" in row for row in rows)
 
 
+def test_progress_in_a_real_80_column_terminal(cli, tmp_path):
+    """``fembsptet mesh`` with its stderr on a pseudo-terminal of 80 columns (as an xterm gives),
+    a run long enough (about 3 s) for the bar to show: every screen row fits in 80 columns, the percentage never goes back within a stage, and the
+    run ends with the summary on stdout."""
+    import fcntl
+    import pty
+    import struct
+    import termios
+
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+    env = dict(os.environ, TERM="xterm")
+    env.pop("COLUMNS", None)
+    env.pop("LINES", None)
+    proc = subprocess.Popen([cli, "mesh", os.path.join(ROOT, "tests", "data", "cad",
+                                                       "bracket.step"),
+                             "--order", "2", "--size", "2", "-o", str(tmp_path / "b.vtu")],
+                            stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL,
+                            env=env)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # the slave side closed: the process has ended
+            break
+        if not data:
+            break
+        chunks.append(data)
+    out, _ = proc.communicate(timeout=300)
+    os.close(master)
+    assert proc.returncode == 0
+    text = ANSI.sub("", b"".join(chunks).decode("utf-8", "replace"))
+    rows = [row for line in text.split("\n") for row in line.split("\r")]
+    assert max(len(row.rstrip()) for row in rows) <= 80, max(rows, key=len)
+    shown = [(m.group(1).strip(), int(m.group(2)))
+             for m in re.finditer(r"fembsptet ([^\n\r%]*?)\s+[━╸╺ ]*\s*(\d+)%", text)]
+    assert shown, text[-2000:]
+    for (stage, a), (next_stage, b) in zip(shown, shown[1:]):
+        if stage == next_stage:
+            assert b >= a, (stage, a, b)
+    assert out.decode().startswith("read ")
+
+
 def test_mesh_with_stderr_redirected_writes_plain_lines_and_a_summary(cli, tmp_path):
     err = tmp_path / "err.txt"
     out = tmp_path / "o.inp"
