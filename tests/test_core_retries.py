@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Inputs on which the core's first attempt gets stuck, and the retries that mesh them.
 
-``tetrahedralize`` (cpp_module/src/mesher.cpp) retries when its Steiner removal cannot move a
+``tetrahedralize`` (cpp_module/src/core/mesher.cpp) retries when its Steiner removal cannot move a
 surface Steiner point inside: first with the other refinement of the covered faces (along whole
 input edge lines), then with other BSP partitions (``BspComplex::set_candidate_shift`` 1, 2).
 The first attempt starts the BSP from the Delaunay tetrahedralization of the

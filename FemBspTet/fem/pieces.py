@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The out-of-core mode: a solid too big for the memory budget cut into pieces, each meshed by the
 core alone and written to disk, the pieces read back as one mesh
-(``cpp_module/include/bsptet/out_of_core.h``).
+(``cpp_module/include/bsptet/pieces/out_of_core.h``).
 
     mesh, stats = tetrahedralize_out_of_core(surfaces, max_memory=4 << 30)
 """
@@ -26,7 +26,7 @@ OUT_OF_CORE_HOLD_PER_TRIANGLE = 256
 
 def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None, cancel=None):
     """Meshes like :func:`tetrahedralize`, in pieces small enough for ``max_memory`` bytes: the
-    out-of-core mode (``cpp_module/include/bsptet/out_of_core.h``; the paper's Sec. 4.3 swaps
+    out-of-core mode (``cpp_module/include/bsptet/pieces/out_of_core.h``; the paper's Sec. 4.3 swaps
     finished cells to disk, this core's peak being in its seed instead the solid is cut).
 
     Each solid is cut into pieces along caps inside it made of its own vertices and points of

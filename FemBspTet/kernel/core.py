@@ -11,7 +11,7 @@
 ``duplicate_points``, ``unreferenced_points``, ``inconsistent_midnodes``, ...), ``volume_equal``,
 ``tet_volume``, ``surface_volume``, ``steiner_points``, ``boundary_steiner_points``, ``messages``
 (the first problems, with indices) and ``quality`` (dihedral angles, radius-edge ratios). The
-conditions are listed in ``cpp_module/include/bsptet/mesh_check.h``.
+conditions are listed in ``cpp_module/include/bsptet/mesh/mesh_check.h``.
 """
 
 import contextlib
@@ -83,7 +83,7 @@ def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_
 def check_surface(surface: Surface, reorient=False, max_reported_pairs=1000, self_intersections=True):
     """Checks that ``surface`` bounds a solid the mesher can fill, exactly, before any meshing.
 
-    The checks and their order are in ``cpp_module/include/bsptet/surface_check.h``: finite
+    The checks and their order are in ``cpp_module/include/bsptet/input/surface_check.h``: finite
     coordinates, indices, degenerate and duplicate triangles, open and non-manifold edges,
     consistent orientation, non-manifold vertices, self-intersections, shells facing the right
     way (outer shells outward, cavities inward). ``reorient=True`` flips triangles to make the
@@ -199,8 +199,9 @@ def native_core_options(options):
 def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
     """Tetrahedralizes the solid(s) bounded by ``surfaces`` (a Surface or a list, one per solid).
 
-    BSP-assisted and exact (cpp_module/include/bsptet/mesher.h): the output boundary is the input
-    triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is positive.
+    BSP-assisted and exact (cpp_module/include/bsptet/core/mesher.h): the output boundary is the
+    input triangulation (no Steiner point on it unless ``allow_boundary_steiner``); every tet is
+    positive.
     Each surface is checked first (:func:`check_surface`); the check's self-intersection search
     runs on a second thread while the core meshes (``check_and_tetrahedralize``), with the same
     errors as checking first.
@@ -381,7 +382,8 @@ def signed_volume(surface: Surface) -> float:
 
 # ---- Quality stage -----------------------------------------------------------------
 
-#: Options of the quality stage (cpp_module/include/bsptet/quality_refine.h), with their meaning.
+#: Options of the quality stage (cpp_module/include/bsptet/refine/quality_refine.h), with their
+#: meaning.
 REFINE_OPTIONS = {
     "size": "target edge length h (model units; edges longer than 2 h are split, as FreeCAD's CharacteristicLengthMax for Gmsh)",
     "min_size": "edges shorter than 2 min_size are never split (default: smallest size / 8)",

@@ -20,8 +20,8 @@ import traceback
 
 class ErrorCode(str, enum.Enum):
     """What an :class:`InputError` is about (``error.code``), as the core names it
-    (``cpp_module/include/bsptet/errors.h``, bound as ``_bsptet.ErrorCode``; a test keeps the two
-    equal), and the codes of this package's own input errors. A member equals its string."""
+    (``cpp_module/include/bsptet/numerics/errors.h``, bound as ``_bsptet.ErrorCode``; a test keeps
+    the two equal), and the codes of this package's own input errors. A member equals its string."""
 
     BAD_ARGUMENT = "bad_argument"
     NON_FINITE_COORDINATE = "non_finite_coordinate"

@@ -11,16 +11,16 @@
 
 #include "bsptet/cad/cad_distance.h"
 #include "bsptet/cad/cad_model.h"
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 #include "bsptet/fem/fem_faces.h"
 #include "bsptet/fem/fem_mesh.h"
-#include "bsptet/mesh_check.h"
-#include "bsptet/mesher.h"
-#include "bsptet/out_of_core.h"
-#include "bsptet/predicates.h"
-#include "bsptet/surface_check.h"
-#include "bsptet/quality_refine.h"
-#include "bsptet/tet10.h"
+#include "bsptet/mesh/mesh_check.h"
+#include "bsptet/core/mesher.h"
+#include "bsptet/pieces/out_of_core.h"
+#include "bsptet/numerics/predicates.h"
+#include "bsptet/input/surface_check.h"
+#include "bsptet/refine/quality_refine.h"
+#include "bsptet/refine/tet10.h"
 
 namespace py = pybind11;
 using namespace bsptet;

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "bsptet/errors.h"
-#include "bsptet/mesh_io.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/mesh/mesh_io.h"
 #include "fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -8,10 +8,10 @@
 #include <map>
 #include <utility>
 
-#include "bsptet/errors.h"
-#include "bsptet/self_intersection.h"
-#include "bsptet/surface_check.h"
-#include "bsptet/triangle_intersection.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/input/self_intersection.h"
+#include "bsptet/input/surface_check.h"
+#include "bsptet/input/triangle_intersection.h"
 #include "fuzz_input.h"
 
 using namespace bsptet;

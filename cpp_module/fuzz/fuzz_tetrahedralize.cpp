@@ -9,10 +9,10 @@
 #include <cstdio>
 #include <vector>
 
-#include "bsptet/errors.h"
-#include "bsptet/mesh_check.h"
-#include "bsptet/mesher.h"
-#include "bsptet/surface_check.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/mesh/mesh_check.h"
+#include "bsptet/core/mesher.h"
+#include "bsptet/input/surface_check.h"
 #include "fuzz_input.h"
 
 using namespace bsptet;

@@ -15,10 +15,10 @@
 #include <string>
 
 #include "bsptet/cad/cad_model.h"
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 #include "bsptet/fem/fem_io.h"
 #include "bsptet/fem/fem_mesh.h"
-#include "bsptet/mesh_io.h"
+#include "bsptet/mesh/mesh_io.h"
 
 int main(int argc, char** argv) {
   using namespace bsptet;

@@ -35,12 +35,12 @@
 #include <cstring>
 #include <string>
 
-#include "bsptet/errors.h"
-#include "bsptet/mesh_check.h"
-#include "bsptet/mesh_io.h"
-#include "bsptet/mesher.h"
-#include "bsptet/out_of_core.h"
-#include "bsptet/surface_check.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/mesh/mesh_check.h"
+#include "bsptet/mesh/mesh_io.h"
+#include "bsptet/core/mesher.h"
+#include "bsptet/pieces/out_of_core.h"
+#include "bsptet/input/surface_check.h"
 
 using namespace bsptet;
 

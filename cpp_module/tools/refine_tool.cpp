@@ -17,11 +17,11 @@
 #include <cstring>
 #include <string>
 
-#include "bsptet/errors.h"
-#include "bsptet/mesh_check.h"
-#include "bsptet/mesh_io.h"
-#include "bsptet/mesher.h"
-#include "bsptet/quality_refine.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/mesh/mesh_check.h"
+#include "bsptet/mesh/mesh_io.h"
+#include "bsptet/core/mesher.h"
+#include "bsptet/refine/quality_refine.h"
 
 using namespace bsptet;
 

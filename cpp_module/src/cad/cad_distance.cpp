@@ -19,7 +19,7 @@
 #include <gp_Pnt.hxx>
 
 #include "bsptet/cad/cad_projection.h"
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::cad {
 namespace {

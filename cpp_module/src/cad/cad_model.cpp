@@ -18,7 +18,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Vertex.hxx>
 
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::cad {
 namespace {

@@ -28,7 +28,7 @@
 #include <gp_Pnt.hxx>
 #include <gp_Pnt2d.hxx>
 
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::cad {
 namespace {

@@ -27,7 +27,7 @@
 
 #include "bsptet/cad/edge_mesher.h"
 #include "bsptet/cad/face_mesher.h"
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::cad {
 namespace {

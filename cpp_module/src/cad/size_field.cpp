@@ -17,7 +17,7 @@
 #include <GeomAbs_SurfaceType.hxx>
 #include <TopoDS.hxx>
 
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::cad {
 namespace {

@@ -6,7 +6,7 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "bsptet/predicates.h"
+#include "bsptet/numerics/predicates.h"
 
 namespace bsptet::cad {
 namespace {

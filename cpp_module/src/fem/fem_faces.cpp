@@ -13,7 +13,7 @@
 
 #include "bsptet/cad/cad_projection.h"
 #include "bsptet/cad/cad_surface.h"
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::fem {
 namespace {

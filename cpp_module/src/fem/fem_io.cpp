@@ -6,7 +6,7 @@
 #include <fstream>
 #include <limits>
 
-#include "bsptet/errors.h"
+#include "bsptet/numerics/errors.h"
 
 namespace bsptet::fem {
 

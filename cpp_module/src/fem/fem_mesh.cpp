@@ -12,11 +12,11 @@
 
 #include "bsptet/cad/cad_projection.h"
 #include "bsptet/cad/cad_surface.h"
-#include "bsptet/errors.h"
-#include "bsptet/mesher.h"
-#include "bsptet/quality_refine.h"
-#include "bsptet/tet10.h"
-#include "bsptet/tet_shape.h"
+#include "bsptet/numerics/errors.h"
+#include "bsptet/core/mesher.h"
+#include "bsptet/refine/quality_refine.h"
+#include "bsptet/refine/tet10.h"
+#include "bsptet/mesh/tet_shape.h"
 
 namespace bsptet::fem {
 namespace {

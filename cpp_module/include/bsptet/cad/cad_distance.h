@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "bsptet/cad/cad_model.h"
-#include "bsptet/types.h"
+#include "bsptet/mesh/types.h"
 
 namespace bsptet::cad {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // FemBspTet CAD layer: points put onto the CAD faces and edges of a model, the projection hook of
-// the quality stage (refine_mesh.h ProjectionHook) backed by OpenCASCADE.
+// the quality stage (mesh/projection_hook.h ProjectionHook) backed by OpenCASCADE.
 //
 //   ProjectionHook hook = make_projection_hook(model);   // hook(point, face, other_face)
 //   double d = distance_to_face(model, face, point);       // to the bounded face (tests)
@@ -35,8 +35,8 @@
 #include <vector>
 
 #include "bsptet/cad/cad_model.h"
-#include "bsptet/refine_mesh.h"
-#include "bsptet/types.h"
+#include "bsptet/mesh/projection_hook.h"
+#include "bsptet/mesh/types.h"
 
 namespace bsptet::cad {
 

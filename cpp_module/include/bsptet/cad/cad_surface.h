@@ -29,7 +29,7 @@
 
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/cad/size_field.h"
-#include "bsptet/types.h"
+#include "bsptet/mesh/types.h"
 
 namespace bsptet::cad {
 

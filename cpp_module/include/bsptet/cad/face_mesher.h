@@ -45,7 +45,7 @@
 #include <TopoDS_Face.hxx>
 
 #include "bsptet/cad/uv_polygon.h"
-#include "bsptet/types.h"
+#include "bsptet/mesh/types.h"
 
 namespace bsptet::cad {
 

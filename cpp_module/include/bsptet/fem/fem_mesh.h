@@ -44,7 +44,7 @@
 #include "bsptet/cad/cad_model.h"
 #include "bsptet/cad/cad_projection.h"
 #include "bsptet/cad/cad_surface.h"
-#include "bsptet/types.h"
+#include "bsptet/mesh/types.h"
 
 namespace bsptet::fem {
 
