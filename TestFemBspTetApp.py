@@ -28,7 +28,7 @@ class TestFemBspTetApp(unittest.TestCase):
         part.Shape = Part.makeBox(40, 20, 10).cut(
             Part.makeCylinder(5, 10, FreeCAD.Vector(20, 10, 0)))
         self.doc.recompute()
-        obj = FemBspTet.make_mesher(self.doc, part, ElementOrder="1st", CompareWithTetGen=False)
+        obj = FemBspTet.make_mesher(self.doc, part, ElementOrder="1st", CompareWithPeers=False)
         self.assertEqual(obj.Proxy.Type, "Fem::FemMeshBspTet")
         result = FemBspTet.run_mesher(obj)
         fem = obj.FemMesh

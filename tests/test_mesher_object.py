@@ -102,6 +102,8 @@ def test_make_mesher_refuses_unknown_properties(doc, fc):
     part = add_part(doc, fc, block_with_hole(fc))
     with pytest.raises(InputError, match="unknown mesher property CharacteristicLength;"):
         FemBspTet.make_mesher(doc, part, CharacteristicLength=3)
+    with pytest.raises(InputError, match="CompareWithTetGen is called CompareWithPeers"):
+        FemBspTet.make_mesher(doc, part, CompareWithTetGen=False)
     assert [o.Name for o in doc.Objects] == [part.Name]
 
 

@@ -263,6 +263,10 @@ def make_mesher(doc, part=None, name="MeshBspTet", **properties):
     removed = set(properties) & set(REMOVED_PARAMETERS.values())
     if removed:
         raise InputError("mesher property: " + removed_parameter_message(removed))
+    renamed = sorted(set(properties) & set(RENAMED_PARAMETERS))
+    if renamed:
+        raise InputError("mesher property %s is called %s: use that name"
+                         % (renamed[0], RENAMED_PARAMETERS[renamed[0]]))
     unknown = set(properties) - known
     if unknown:
         raise InputError("unknown mesher propert%s %s; the parameters are %s"
