@@ -535,6 +535,37 @@ def test_save_and_reload(doc, fc, tmp_path):
         freecad.closeDocument(d2.Name)
 
 
+def test_a_document_saved_by_freecad_0_20_opens_with_its_mesher_and_mesh(fc, tmp_path):
+    """tests/data/freecad/mesher_freecad_0_20.FCStd was saved by FreeCAD 0.20.2
+    (make_mesher_document.py beside it). On every FreeCAD the tests run on (0.20.2 and 1.0) it
+    opens with the mesher object, its link to the block, its tet10 mesh and the analysis holding
+    it, and meshes again."""
+    import shutil
+
+    freecad = fc[0]
+    path = str(tmp_path / "mesher_freecad_0_20.FCStd")
+    shutil.copy(os.path.join(os.path.dirname(DATA), "freecad", "mesher_freecad_0_20.FCStd"),
+                path)
+    d = freecad.openDocument(path)
+    try:
+        o = d.getObject("MeshBspTet")
+        assert o.Proxy.Type == "Fem::FemMeshBspTet"
+        assert source_of(o).Name == "Block"
+        if "Fem::FemMeshShapeBaseObjectPython" in d.supportedTypes():  # FreeCAD 1.x
+            assert "Shape" in o.PropertiesList and "Part" not in o.PropertiesList
+        fem = o.FemMesh
+        assert fem.NodeCount == o.Nodes > 0 and fem.VolumeCount == o.Tetrahedra > 0
+        assert {len(fem.getElementNodes(e)) for e in fem.Volumes} == {10}
+        assert o in d.getObject("Analysis").Group
+        assert o.ElementDimension == "From Shape" and o.CompareWithPeers is False
+        nodes = o.Nodes
+        FemBspTet.run_mesher(o)
+        assert o.FemMesh.NodeCount == o.Nodes > 0 and o.MeshStatus.startswith("meshed")
+        assert abs(o.Nodes - nodes) <= 0.2 * nodes  # the same part at the same size
+    finally:
+        freecad.closeDocument(d.Name)
+
+
 def test_object_of_0_20_files_opens_and_meshes(doc, fc, tmp_path):
     """A mesher object as FreeCAD 0.20/0.21 make it (Fem::FemMeshObjectPython with our Part link)
     opens and meshes; on FreeCAD 1.x its Part link becomes a global Shape link on restore."""
