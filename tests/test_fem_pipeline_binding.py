@@ -38,9 +38,48 @@ def check(points, tets, tet_solid, triangles, triangle_face, stats, order, solid
     assert report["inverted_tets"] == 0 and report["flat_tets"] == 0
 
 
+def options(**values):
+    o = _bsptet.FemOptions()
+    for name, value in values.items():
+        setattr(o, name, value)
+    return o
+
+
+def test_the_options_schema_is_one_table():
+    """FemOptions is bound from fem_mesh.h's for_each_fem_option; the Python layer, the CLI and
+    the FreeCAD object map onto it and nothing else."""
+    from FemBspTet.cli.main import FEM_OPTION_OF_FLAG
+    from FemBspTet.fem.cad_mesh import fem_options
+    from FemBspTet.fem.mesh_pipeline import FEM_OPTION_OF_PARAMETER, MeshParameters
+
+    names = list(_bsptet.FemOptions.names)
+    assert names == ["size", "min_size", "size_by_face", "points_per_circle", "grading", "order",
+                     "optimize_rounds", "face_rounds"]
+    o = _bsptet.FemOptions()
+    assert (o.size, o.min_size, o.order, o.grading, o.points_per_circle) == (0, 0, 2, 0.3, 12)
+    with pytest.raises(AttributeError):
+        o.no_such_option = 1
+    # the Python builder refuses names outside the schema
+    with pytest.raises(ValueError, match="unknown FEM option"):
+        fem_options("x", sizee=1.0)
+    assert fem_options("x", size=2.0, order=1).order == 1
+    # the CLI's FEM flags and the FreeCAD object's parameters name schema options
+    assert set(FEM_OPTION_OF_FLAG.values()) <= set(names)
+    fields = {f for f in MeshParameters.__dataclass_fields__}
+    assert set(FEM_OPTION_OF_PARAMETER) <= fields
+    assert set(FEM_OPTION_OF_PARAMETER.values()) <= set(names)
+    # the statistics keys are the FemStats fields
+    stats = _bsptet.FemStats()
+    keys = set(stats.to_dict())
+    assert {"solids", "faces", "size", "nodes", "tets", "min_dihedral_deg", "seconds_total",
+            "median_tet_min_dihedral_deg", "refine_seconds_by_pass"} <= keys
+    assert all(hasattr(stats, k) for k in keys)
+
+
 @pytest.mark.parametrize("order", [1, 2])
 def test_mesh_cad_file_red_cube_blue_cylinder(order):
-    out = _bsptet.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"), order=order)
+    out = _bsptet.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"),
+                                options=options(order=order))
     check(*out, order=order, solids=2, faces=9)
     stats = out[-1]
     assert stats["min_dihedral_deg"] > 0
@@ -52,9 +91,9 @@ def test_mesh_cad_file_red_cube_blue_cylinder(order):
 def test_bad_options_and_files_raise_value_errors():
     path = os.path.join(DATA, "red_cube_blue_cylinder.step")
     with pytest.raises(ValueError, match="order"):
-        _bsptet.mesh_cad_file(path, order=3)
+        _bsptet.mesh_cad_file(path, options=options(order=3))
     with pytest.raises(ValueError, match="size"):
-        _bsptet.mesh_cad_file(path, size=-1.0)
+        _bsptet.mesh_cad_file(path, options=options(size=-1.0))
     with pytest.raises(ValueError):
         _bsptet.mesh_cad_file(os.path.join(DATA, "no_such_part.step"))
     with pytest.raises(ValueError):
@@ -79,7 +118,7 @@ def test_mesh_cad_brep_nodes_found_by_face(order):
     shape = Part.makeBox(60, 40, 8).cut(Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0)))
     shape.Placement = freecad.Placement(freecad.Vector(3.5, -7.25, 11.0),
                                         freecad.Rotation(freecad.Vector(1, 2, 3), 37.0))
-    out = _bsptet.mesh_cad_brep(shape.exportBrepToString(), order=order)
+    out = _bsptet.mesh_cad_brep(shape.exportBrepToString(), options=options(order=order))
     points, tets, _, triangles, triangle_face, _ = out
     check(*out, order=order, solids=1, faces=len(shape.Faces))
     fem = Fem.FemMesh()

@@ -55,6 +55,10 @@ from ..fem.pieces import tetrahedralize_out_of_core
 
 
 # Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
+#: The FEM path's options (``FemOptions``, the schema of ``fem/fem_mesh.h``) that ``mesh`` flags
+#: set for CAD input: argparse destination -> option (None: the option's default).
+FEM_OPTION_OF_FLAG = {"size": "size", "min_size": "min_size", "order": "order"}
+
 STATS_KEYS = (
     "input_points",
     "input_triangles",
@@ -206,8 +210,9 @@ def _mesh_cad_fem(args, progress):
                          "OpenCASCADE's display tessellation with the core instead",
                          where=args.input)
 
-    result = mesh_cad_file(args.input, size=args.size or 0.0, min_size=args.min_size or 0.0,
-                           order=args.order, progress=progress)
+    result = mesh_cad_file(args.input, progress=progress,
+                           **{option: getattr(args, dest) for dest, option in
+                              FEM_OPTION_OF_FLAG.items()})
     return result.mesh, result.stats, result.groups
 
 

@@ -102,21 +102,43 @@ def _touching_solids(points, corner_tets, tet_solid):
     return [list(p) for p in sorted(pairs)]
 
 
-def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face):
-    if order not in (1, 2):
+def fem_options(source="", **values):
+    """The native FemOptions (the options schema, ``fem/fem_mesh.h`` for_each_fem_option) with
+    ``values`` set: ``size``, ``min_size``, ``order``, ``size_by_face``, ``points_per_circle``,
+    ``grading``, ``optimize_rounds``, ``face_rounds`` (None: the default). Raises InputError for
+    an unknown name or a value out of range, naming ``source``."""
+    options = native().FemOptions()
+    unknown = sorted(set(values) - set(native().FemOptions.names))
+    if unknown:
+        raise InputError("unknown FEM option(s) %s; the options are %s"
+                         % (", ".join(unknown), ", ".join(native().FemOptions.names)), where=source)
+    order = values.get("order")
+    if order is not None and order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}", where=source)
-    for name, value in (("size", size), ("min_size", min_size)):
-        if value is None:
-            continue
-        if not np.isfinite(value) or value < 0:
+    for name in ("size", "min_size"):
+        value = values.get(name)
+        if value is not None and (not np.isfinite(value) or value < 0):
             raise InputError(f"{name} must be a finite number >= 0 (0: automatic), got {value}",
                              where=source)
+    for name, value in values.items():
+        if value is None:
+            continue
+        if name == "size_by_face":
+            value = {int(k): float(v) for k, v in value.items()}
+        try:
+            setattr(options, name, value)
+        except TypeError:
+            raise InputError("FEM option %s: cannot use %r" % (name, value), where=source) from None
+    return options
 
+
+def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face):
+    options = fem_options(source, size=size, min_size=min_size, order=order,
+                          size_by_face=size_by_face)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                               source=""), "FEM mesh"):
         points, tets, tet_solid, tri, tri_face, stats = native_call(
-            size=float(size or 0.0), min_size=float(min_size or 0.0), order=int(order),
-            size_by_face={int(k): float(v) for k, v in (size_by_face or {}).items()},
+            options=options,
             progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
             cancel=cancel)
     mesh = TetMesh(points=np.asarray(points), tets=np.asarray(tets, dtype=np.int64), source=source)
@@ -196,14 +218,12 @@ def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, ca
     triangles at the size field, tria6 mid-nodes on the CAD (``cpp_module/include/bsptet/fem/
     fem_faces.h``): shell and plane analyses. Raises InputError (no face, bad option) or
     MeshingError."""
-    if order not in (1, 2):
-        raise InputError(f"order must be 1 or 2, got {order}", where=source)
+    options = fem_options(source, size=size, min_size=min_size, order=order,
+                          size_by_face=size_by_face)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                              source=""), "FEM surface mesh"):
         points, _tets, _solid, tri, tri_face, stats = native().mesh_cad_brep(
-            brep, dimension=2, size=float(size or 0.0), min_size=float(min_size or 0.0),
-            order=int(order), size_by_face={int(k): float(v) for k, v in
-                                            (size_by_face or {}).items()},
+            brep, dimension=2, options=options,
             progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
             cancel=cancel)
     points = np.asarray(points)

@@ -50,6 +50,9 @@ PROPERTY_OF = {
     "dimension": "ElementDimension",
 }
 
+#: The native FemOptions (the schema of ``fem/fem_mesh.h``) each MeshParameters field sets.
+FEM_OPTION_OF_PARAMETER = {"max_size": "size", "min_size": "min_size", "order": "order"}
+
 #: Parameters of the former tessellation pipeline, by FreeCAD property name: the FEM path meshes
 #: the CAD surface itself, so none of them has a meaning any more. Named in the message that
 #: refuses them (``mesh_shape``, ``make_mesher``); saved documents lose them on opening
@@ -282,8 +285,9 @@ def mesh_brep(brep, face_count, params, progress=None, cancel=None, source="", s
 
     mesher = mesh_cad_faces_brep if params.dimension == 2 else mesh_cad_brep
     with _named_errors(source):
-        fem = mesher(brep, size=params.max_size, min_size=params.min_size, order=params.order,
-                     progress=fem_progress, cancel=cancel, source=source or "shape")
+        fem = mesher(brep, progress=fem_progress, cancel=cancel, source=source or "shape",
+                     **{option: getattr(params, field)
+                        for field, option in FEM_OPTION_OF_PARAMETER.items()})
     if int(fem.stats["faces"]) != int(face_count):
         raise InternalError("%s: the FEM path read %d CAD faces from the BREP, the shape has %d"
                             % (source or "shape", fem.stats["faces"], face_count))

@@ -148,22 +148,17 @@ MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effor
 // The FEM pipeline (fem/fem_mesh.h) on a model read by `read`, with the options as arguments.
 // Returns (points (n, 3), tets (k, 4 or 10), tet_solid (k,), triangles (f, 3 or 6),
 // triangle_face (f,), stats dict).
-py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension, double size,
-                   double min_size, int order, double grading, double points_per_circle,
-                   const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
-                   const py::object& progress, const py::object& cancel) {
+py::dict fem_stats_dict(const fem::FemStats& st) {
+  py::dict d;
+  fem::for_each_fem_stat([&](const char* name, auto member) { d[name] = st.*member; });
+  return d;
+}
+
+py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension,
+                   fem::FemOptions o, const py::object& progress, const py::object& cancel) {
   if (dimension != 2 && dimension != 3)
     throw InputError(ErrorCode::kBadArgument, "fem", -1,
                      "option dimension must be 2 (the faces) or 3 (the solids), got " + std::to_string(dimension));
-  fem::FemOptions o;
-  o.size = size;
-  o.min_size = min_size;
-  o.order = order;
-  o.grading = grading;
-  o.points_per_circle = points_per_circle;
-  o.size_by_face = size_by_face;
-  o.optimize_rounds = optimize_rounds;
-  o.face_rounds = face_rounds;
   fem::FemMesh fm;
   fem::FemStats st;
   run_without_gil(o, progress, cancel, [&]() {
@@ -180,44 +175,9 @@ py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, in
   std::copy(fm.tri.begin(), fm.tri.end(), tri.mutable_data());
   py::array_t<std::int64_t> tri_face(static_cast<py::ssize_t>(fm.tri_face.size()));
   std::copy(fm.tri_face.begin(), fm.tri_face.end(), tri_face.mutable_data());
-  py::dict d;
-  d["solids"] = st.solids;
-  d["faces"] = st.faces;
-  d["size"] = st.size;
-  d["min_size"] = st.min_size;
-  d["order"] = order;
+  py::dict d = fem_stats_dict(st);
+  d["order"] = o.order;
   d["dimension"] = dimension;
-  d["surface_nodes"] = st.surface_nodes;
-  d["surface_triangles"] = st.surface_triangles;
-  d["shared_faces"] = st.shared_faces;
-  d["core_points"] = st.core_points;
-  d["core_tets"] = st.core_tets;
-  d["core_steiner_points"] = st.core_steiner_points;
-  d["surface_splits"] = st.surface_splits;
-  d["splits_fixed_surface"] = st.splits_fixed_surface;
-  d["projection_refused"] = st.projection_refused;
-  d["midnodes_projected"] = st.midnodes_projected;
-  d["midnodes_straightened"] = st.midnodes_straightened;
-  d["curving_conflicts_left"] = st.curving_conflicts_left;
-  d["midnodes_relaxed_tets"] = st.midnodes_relaxed_tets;
-  d["midnodes_moved_interior"] = st.midnodes_moved_interior;
-  d["midnodes_moved_surface"] = st.midnodes_moved_surface;
-  d["lift_insertions"] = st.lift_insertions;
-  d["midnodes_reconciled"] = st.midnodes_reconciled;
-  d["midnodes_straightened_at_merge"] = st.midnodes_straightened_at_merge;
-  d["nodes"] = st.nodes;
-  d["corner_nodes"] = st.corner_nodes;
-  d["tets"] = st.tets;
-  d["boundary_triangles"] = st.boundary_triangles;
-  d["min_dihedral_deg"] = st.min_dihedral_deg;
-  d["median_tet_min_dihedral_deg"] = st.median_tet_min_dihedral_deg;
-  d["tets_below_10_deg"] = st.tets_below_10_deg;
-  d["seconds_surface"] = st.seconds_surface;
-  d["seconds_core"] = st.seconds_core;
-  d["seconds_refine"] = st.seconds_refine;
-  d["seconds_merge"] = st.seconds_merge;
-  d["seconds_total"] = st.seconds_total;
-  d["refine_seconds_by_pass"] = st.refine_seconds_by_pass;
   return py::make_tuple(points_array(fm.mesh), tets_array(fm.mesh), tet_solid, tri, tri_face, d);
 }
 
@@ -570,43 +530,47 @@ PYBIND11_MODULE(_bsptet, m) {
       "dimension 3: meshes every solid of a CAD model: surface at the size field, exact core, refinement "
       "with new surface points and tet10 mid-nodes on the CAD, one mesh of all solids (fem/fem_mesh.h); "
       "dimension 2: every CAD face as triangles (tria6 mid-nodes on the CAD), no tets (fem/fem_faces.h). "
-      "size / min_size: CharacteristicLengthMax / Min in model units (0: automatic, diagonal / 20 and "
-      "size / 50); order 1 (tet4) or 2 (tet10); grading per unit length; points_per_circle for curved "
-      "faces (0: off); size_by_face {0-based face: size}. Returns (points (n, 3), tets (k, 4 or 10), "
+      "options: a FemOptions (size / min_size: CharacteristicLengthMax / Min in model units, 0: automatic, "
+      "diagonal / 20 and size / 50; order 1 (tet4) or 2 (tet10); grading per unit length; points_per_circle "
+      "for curved faces, 0: off; size_by_face {0-based face: size}). Returns (points (n, 3), tets (k, 4 or 10), "
       "tet_solid (k,), triangles (f, 3 or 6) of every CAD face once, triangle_face (f,) 0-based CAD "
       "face, stats dict). Raises InputError (unreadable or unmeshable CAD, bad option) or MeshingError.";
-  const fem::FemOptions fem_defaults;
+  {
+    // The options schema (fem/fem_mesh.h for_each_fem_option) and the statistics, as classes.
+    py::class_<fem::FemOptions> options(m, "FemOptions",
+                                        "Options of the FEM pipeline from CAD (fem/fem_mesh.h FemOptions); "
+                                        "FreeCAD's CharacteristicLengthMax is size.");
+    options.def(py::init<>());
+    fem::for_each_fem_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
+    options.def_property_readonly_static("names", [](py::object) {
+      py::list names;
+      fem::for_each_fem_option([&](const char* name, auto) { names.append(name); });
+      return names;
+    });
+    py::class_<fem::FemStats> stats(m, "FemStats", "Figures of a run of the FEM pipeline (fem/fem_mesh.h FemStats).");
+    stats.def(py::init<>());
+    fem::for_each_fem_stat([&](const char* name, auto member) { stats.def_readonly(name, member); });
+    stats.def("to_dict", &fem_stats_dict, "The figures as the statistics dict (its keys are the field names).");
+  }
   m.def(
       "mesh_cad_file",
-      [](const std::string& path, int dimension, double size, double min_size, int order, double grading,
-         double points_per_circle, const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
-         py::object progress, py::object cancel) {
+      [](const std::string& path, int dimension, const fem::FemOptions& options, py::object progress,
+         py::object cancel) {
         return mesh_cad([&](cad::CadContent content) { return cad::read_cad_file(path, content); }, dimension,
-                        size, min_size, order, grading, points_per_circle, size_by_face, optimize_rounds,
-                        face_rounds, progress, cancel);
+                        options, progress, cancel);
       },
-      py::arg("path"), py::arg("dimension") = 3, py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
-      py::arg("order") = fem_defaults.order, py::arg("grading") = fem_defaults.grading,
-      py::arg("points_per_circle") = fem_defaults.points_per_circle,
-      py::arg("size_by_face") = std::map<int, double>{}, py::arg("optimize_rounds") = fem_defaults.optimize_rounds,
-      py::arg("face_rounds") = fem_defaults.face_rounds, py::arg("progress") = py::none(),
-      py::arg("cancel") = py::none(),
+      py::arg("path"), py::arg("dimension") = 3, py::arg("options") = fem::FemOptions{},
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       (std::string("A STEP, BREP or IGES file (by extension). ") + mesh_cad_doc).c_str());
   m.def(
       "mesh_cad_brep",
-      [](const std::string& brep, int dimension, double size, double min_size, int order, double grading,
-         double points_per_circle, const std::map<int, double>& size_by_face, int optimize_rounds, int face_rounds,
-         py::object progress, py::object cancel) {
+      [](const std::string& brep, int dimension, const fem::FemOptions& options, py::object progress,
+         py::object cancel) {
         return mesh_cad([&](cad::CadContent content) { return cad::read_brep_string(brep, "BREP string", content); },
-                        dimension, size, min_size, order, grading, points_per_circle, size_by_face,
-                        optimize_rounds, face_rounds, progress, cancel);
+                        dimension, options, progress, cancel);
       },
-      py::arg("brep"), py::arg("dimension") = 3, py::arg("size") = fem_defaults.size, py::arg("min_size") = fem_defaults.min_size,
-      py::arg("order") = fem_defaults.order, py::arg("grading") = fem_defaults.grading,
-      py::arg("points_per_circle") = fem_defaults.points_per_circle,
-      py::arg("size_by_face") = std::map<int, double>{}, py::arg("optimize_rounds") = fem_defaults.optimize_rounds,
-      py::arg("face_rounds") = fem_defaults.face_rounds, py::arg("progress") = py::none(),
-      py::arg("cancel") = py::none(),
+      py::arg("brep"), py::arg("dimension") = 3, py::arg("options") = fem::FemOptions{},
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       (std::string("A shape in OpenCASCADE's BREP text (FreeCAD's Shape.exportBrepToString()). ") + mesh_cad_doc)
           .c_str());
 

@@ -160,6 +160,69 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
 /// Throws InputError naming the option when `options` holds a value out of range.
 void check_fem_options(const FemOptions& options);
 
+/// The options schema, stated once: calls f(name, member pointer) for every value option of
+/// FemOptions (not the callbacks). The bindings bind FemOptions from it (FemBspTet's Python
+/// options, the CLI flags and the FreeCAD properties are checked against it by tests).
+template <class F>
+void for_each_fem_option(F&& f) {
+  f("size", &FemOptions::size);
+  f("min_size", &FemOptions::min_size);
+  f("size_by_face", &FemOptions::size_by_face);
+  f("points_per_circle", &FemOptions::points_per_circle);
+  f("grading", &FemOptions::grading);
+  f("order", &FemOptions::order);
+  f("optimize_rounds", &FemOptions::optimize_rounds);
+  f("face_rounds", &FemOptions::face_rounds);
+}
+
+/// The statistics schema, stated once: calls f(name, member pointer) for every figure of FemStats
+/// but the projection counts (cad::ProjectionStats, named "projection_<field>" by the bindings).
+/// The names are the keys of the statistics JSON.
+template <class F>
+void for_each_fem_stat(F&& f) {
+  f("solids", &FemStats::solids);
+  f("faces", &FemStats::faces);
+  f("size", &FemStats::size);
+  f("min_size", &FemStats::min_size);
+  f("surface_nodes", &FemStats::surface_nodes);
+  f("surface_triangles", &FemStats::surface_triangles);
+  f("shared_faces", &FemStats::shared_faces);
+  f("core_points", &FemStats::core_points);
+  f("core_tets", &FemStats::core_tets);
+  f("core_steiner_points", &FemStats::core_steiner_points);
+  f("surface_splits", &FemStats::surface_splits);
+  f("refinement_points", &FemStats::refinement_points);
+  f("interior_splits", &FemStats::interior_splits);
+  f("collapses", &FemStats::collapses);
+  f("splits_fixed_surface", &FemStats::splits_fixed_surface);
+  f("projection_refused", &FemStats::projection_refused);
+  f("midnodes_projected", &FemStats::midnodes_projected);
+  f("midnodes_straightened", &FemStats::midnodes_straightened);
+  f("curving_conflicts_left", &FemStats::curving_conflicts_left);
+  f("midnodes_relaxed_tets", &FemStats::midnodes_relaxed_tets);
+  f("midnodes_moved_interior", &FemStats::midnodes_moved_interior);
+  f("midnodes_moved_surface", &FemStats::midnodes_moved_surface);
+  f("lift_insertions", &FemStats::lift_insertions);
+  f("refine_worst_deg_optimized", &FemStats::refine_worst_deg_optimized);
+  f("refine_worst_deg_curving_room", &FemStats::refine_worst_deg_curving_room);
+  f("refine_worst_deg", &FemStats::refine_worst_deg);
+  f("midnodes_reconciled", &FemStats::midnodes_reconciled);
+  f("midnodes_straightened_at_merge", &FemStats::midnodes_straightened_at_merge);
+  f("nodes", &FemStats::nodes);
+  f("corner_nodes", &FemStats::corner_nodes);
+  f("tets", &FemStats::tets);
+  f("boundary_triangles", &FemStats::boundary_triangles);
+  f("min_dihedral_deg", &FemStats::min_dihedral_deg);
+  f("median_tet_min_dihedral_deg", &FemStats::median_tet_min_dihedral_deg);
+  f("tets_below_10_deg", &FemStats::tets_below_10_deg);
+  f("seconds_surface", &FemStats::seconds_surface);
+  f("seconds_core", &FemStats::seconds_core);
+  f("seconds_refine", &FemStats::seconds_refine);
+  f("seconds_merge", &FemStats::seconds_merge);
+  f("seconds_total", &FemStats::seconds_total);
+  f("refine_seconds_by_pass", &FemStats::refine_seconds_by_pass);
+}
+
 /// The CAD layer's surface options for `options` (size field, face rounds, cancel; no progress).
 cad::CadSurfaceOptions cad_surface_options(const FemOptions& options);
 
