@@ -148,6 +148,14 @@ MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effor
 // The FEM pipeline (fem/fem_mesh.h) on a model read by `read`, with the options as arguments.
 // Returns (points (n, 3), tets (k, 4 or 10), tet_solid (k,), triangles (f, 3 or 6),
 // triangle_face (f,), stats dict).
+py::dict mesh_stats_dict(const MeshStats& st) {
+  py::dict d;
+  for_each_mesh_stat([&](const char* key, auto member) { d[key] = st.*member; });
+  d["interior_steiner_points"] = st.steiner_points - st.boundary_steiner_points;
+  d["bsp_seed"] = st.delaunay_seeded ? "delaunay" : "box";  // what the mesh came from
+  return d;
+}
+
 py::dict fem_stats_dict(const fem::FemStats& st) {
   py::dict d;
   fem::for_each_fem_stat([&](const char* name, auto member) { d[name] = st.*member; });
@@ -250,47 +258,7 @@ PYBIND11_MODULE(_bsptet, m) {
           if (c.contains("max_reported_pairs")) co.max_reported_pairs = c["max_reported_pairs"].cast<std::int64_t>();
           run_without_gil(o, progress, cancel, [&]() { mesh = check_and_tetrahedralize(s, co, o, &st); });
         }
-        py::dict d;
-        d["input_points"] = st.input_points;
-        d["input_triangles"] = st.input_triangles;
-        d["input_planes"] = st.input_planes;
-        d["points"] = st.points;
-        d["tets"] = st.tets;
-        d["steiner_points"] = st.steiner_points;
-        d["boundary_steiner_points"] = st.boundary_steiner_points;
-        d["interior_steiner_points"] = st.steiner_points - st.boundary_steiner_points;
-        d["bsp_nodes"] = st.bsp_nodes;
-        d["convex_cells"] = st.convex_cells;
-        d["inside_cells"] = st.inside_cells;
-        d["bsp_points"] = st.bsp_points;
-        d["seed_tets"] = st.seed_tets;
-        d["seed_untouched_tets"] = st.seed_untouched_tets;
-        d["seed_conflicts"] = st.seed_conflicts;
-        d["seed_fell_back"] = st.seed_fell_back;
-        d["seed_faces_relabelled"] = st.seed_faces_relabelled;
-        d["seed_missing_edges"] = st.seed_missing_edges;
-        d["seed_recovered_edges"] = st.seed_recovered_edges;
-        d["seed_flips"] = st.seed_flips;
-        d["seed_missing_faces"] = st.seed_missing_faces;
-        d["seed_recovered_faces"] = st.seed_recovered_faces;
-        d["bsp_seed"] = st.delaunay_seeded ? "delaunay" : "box";  // what the mesh came from
-        d["steiner_points_before_removal"] = st.steiner_before_removal;
-        d["surface_steiner_points_before_removal"] = st.boundary_steiner_before_removal;
-        d["collapsed"] = st.collapsed;
-        d["relocated"] = st.relocated;
-        d["exact_fallbacks"] = st.exact_fallbacks;
-        d["retried_along_lines"] = st.retried_along_lines;
-        d["retries"] = st.retries;
-        d["bsp_candidate_shift"] = st.bsp_candidate_shift;
-        d["delaunay_cells"] = st.delaunay_cells;
-        d["delaunay_recovered_cells"] = st.delaunay_recovered_cells;
-        d["delaunay_fallback_cells"] = st.delaunay_fallback_cells;
-        d["apex_cells"] = st.apex_cells;
-        d["pulled_cells"] = st.pulled_cells;
-        d["seconds_by_stage"] = st.seconds_by_stage;
-        d["steiner_seconds_by_phase"] = st.steiner_seconds_by_phase;
-        d["steiner_removed_by_phase"] = st.steiner_removed_by_phase;
-        d["seconds_core"] = st.seconds_total;
+        py::dict d = mesh_stats_dict(st);
         return py::make_tuple(points_array(mesh), tets_array(mesh), d);
       },
       py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,

@@ -92,6 +92,51 @@ struct MeshStats {
   double seconds_total = 0;
 };
 
+/// The statistics schema, stated once: calls f(key, member pointer) for every figure of
+/// MeshStats; the keys are those of the statistics JSON (the bindings add the keys computed from
+/// several fields: interior_steiner_points, bsp_seed).
+template <class F>
+void for_each_mesh_stat(F&& f) {
+  f("input_points", &MeshStats::input_points);
+  f("input_triangles", &MeshStats::input_triangles);
+  f("input_planes", &MeshStats::input_planes);
+  f("points", &MeshStats::points);
+  f("tets", &MeshStats::tets);
+  f("steiner_points", &MeshStats::steiner_points);
+  f("boundary_steiner_points", &MeshStats::boundary_steiner_points);
+  f("bsp_nodes", &MeshStats::bsp_nodes);
+  f("convex_cells", &MeshStats::convex_cells);
+  f("inside_cells", &MeshStats::inside_cells);
+  f("bsp_points", &MeshStats::bsp_points);
+  f("seed_tets", &MeshStats::seed_tets);
+  f("seed_untouched_tets", &MeshStats::seed_untouched_tets);
+  f("seed_conflicts", &MeshStats::seed_conflicts);
+  f("seed_fell_back", &MeshStats::seed_fell_back);
+  f("seed_faces_relabelled", &MeshStats::seed_faces_relabelled);
+  f("seed_missing_edges", &MeshStats::seed_missing_edges);
+  f("seed_recovered_edges", &MeshStats::seed_recovered_edges);
+  f("seed_flips", &MeshStats::seed_flips);
+  f("seed_missing_faces", &MeshStats::seed_missing_faces);
+  f("seed_recovered_faces", &MeshStats::seed_recovered_faces);
+  f("steiner_points_before_removal", &MeshStats::steiner_before_removal);
+  f("surface_steiner_points_before_removal", &MeshStats::boundary_steiner_before_removal);
+  f("collapsed", &MeshStats::collapsed);
+  f("relocated", &MeshStats::relocated);
+  f("exact_fallbacks", &MeshStats::exact_fallbacks);
+  f("retried_along_lines", &MeshStats::retried_along_lines);
+  f("retries", &MeshStats::retries);
+  f("bsp_candidate_shift", &MeshStats::bsp_candidate_shift);
+  f("delaunay_cells", &MeshStats::delaunay_cells);
+  f("delaunay_recovered_cells", &MeshStats::delaunay_recovered_cells);
+  f("delaunay_fallback_cells", &MeshStats::delaunay_fallback_cells);
+  f("apex_cells", &MeshStats::apex_cells);
+  f("pulled_cells", &MeshStats::pulled_cells);
+  f("seconds_by_stage", &MeshStats::seconds_by_stage);
+  f("steiner_seconds_by_phase", &MeshStats::steiner_seconds_by_phase);
+  f("steiner_removed_by_phase", &MeshStats::steiner_removed_by_phase);
+  f("seconds_core", &MeshStats::seconds_total);
+}
+
 /// Checks the input surface: finite coordinates, indices in range, no degenerate or duplicate
 /// triangles, every edge shared by exactly two triangles in opposite directions. Throws InputError
 /// naming the first offending triangle or vertex.
