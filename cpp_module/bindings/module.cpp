@@ -145,9 +145,8 @@ MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effor
   return o;
 }
 
-// The FEM pipeline (fem/fem_mesh.h) on a model read by `read`, with the options as arguments.
-// Returns (points (n, 3), tets (k, 4 or 10), tet_solid (k,), triangles (f, 3 or 6),
-// triangle_face (f,), stats dict).
+// The statistics dicts, built from the schemas (core/mesher.h for_each_mesh_stat, fem/fem_mesh.h
+// for_each_fem_stat).
 py::dict mesh_stats_dict(const MeshStats& st) {
   py::dict d;
   for_each_mesh_stat([&](const char* key, auto member) { d[key] = st.*member; });
@@ -162,6 +161,9 @@ py::dict fem_stats_dict(const fem::FemStats& st) {
   return d;
 }
 
+// The FEM pipeline (fem/fem_mesh.h, or fem/fem_faces.h in 2D) on a model read by `read`.
+// Returns (points (n, 3), tets (k, 4 or 10; none in 2D), tet_solid (k,), triangles (f, 3 or 6),
+// triangle_face (f,), stats dict).
 py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension,
                    fem::FemOptions o, const py::object& progress, const py::object& cancel) {
   if (dimension != 2 && dimension != 3)
