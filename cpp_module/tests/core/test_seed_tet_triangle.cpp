@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The seed's tet-triangle test (seed_tet_triangle_relation, bsp_complex.h) on nearly coplanar
-// configurations, against exact arithmetic. Seeds are fixed.
+// The seed's tet-triangle test (seed_tet_triangle_relation, seed_tet_triangle.h) on nearly
+// coplanar configurations, against exact arithmetic. Seeds are fixed.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <random>
 
-#include "bsptet/core/bsp_complex.h"
+#include "bsptet/core/seed_tet_triangle.h"
 #include "bsptet/numerics/exact_float.h"
 #include "bsptet/numerics/predicates.h"
 

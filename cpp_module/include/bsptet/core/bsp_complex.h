@@ -297,11 +297,4 @@ class BspComplex {
   Index corner0_ = -1;  ///< vertex id of the first box corner
 };
 
-/// How a positive tet (corners p, ids pid) and a triangle (corners q, ids qid; a shared id is a
-/// shared corner) meet: 0 when the closed sets are disjoint, 1 when the triangle misses the tet's
-/// interior (they may touch), 2 when it crosses the interior (the seed's conflict lists). Every
-/// answer is exact (rounded tests only shortcut what they certify). Exposed for the tests.
-int seed_tet_triangle_relation(const std::array<Vec3, 4>& p, const std::array<Index, 4>& pid,
-                               const std::array<Vec3, 3>& q, const std::array<Index, 3>& qid);
-
 }  // namespace bsptet

@@ -150,7 +150,7 @@ struct RefineStats {
   std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
   std::int64_t curving_lifts = 0;           ///< order 2 with a hook: interior points lifted so that
-                                            ///< curved elements stay valid (quality_refine.cpp)
+                                            ///< curved elements stay valid (curved_room.h)
   std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element (interior mid-nodes
                                             ///< straight) was still invalid; the tet10 lift mends them
   /// Order 2 with a hook, the tet10 lift (tet10.h make_second_order): tets made valid by moving
@@ -162,7 +162,7 @@ struct RefineStats {
   /// the optimization (and separate_face_tags) is done; after the room made for curved elements
   /// (order 2 with a hook; else the same); and at the end (the output's corner tets). Where the
   /// worst tet of a mesh comes from: a drop from the first to the second is paid for valid curved
-  /// elements (quality_refine.cpp, lift_for_curved_elements). 180 for a mesh without tets.
+  /// elements (curved_room.h, CurvedRoom::lift). 180 for a mesh without tets.
   double worst_deg_optimized = 180, worst_deg_curving_room = 180, worst_deg = 180;
   double seconds = 0;
   /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,

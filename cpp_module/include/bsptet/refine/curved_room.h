@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// FemBspTet quality stage: room for curved 10-node tets (step 2c of quality_refine.h), with a
+// projection hook and order 2, before the mid-nodes are placed (tet10.h).
+//
+// A curved element here is the tet10 of a linear tet whose boundary edges' mid-nodes lie on the
+// true surface (the hook at the edge's midpoint, with the tags of the edge's boundary faces) and
+// whose other mid-nodes are straight; it is valid when certify_tet10 certifies its Jacobian
+// determinant positive (a tet with no curved edge is valid as its corner tet is positive).
+//
+// Contract:
+//  * Takes a valid RefineMesh whose boundary is final (no later step splits a surface edge),
+//    RefineOptions already checked, the stats it adds its counts to, the TargetSizes and the
+//    MeshOptimizer of the stage; all must outlive it.
+//  * lift() does nothing without a hook or with order 1. Else it lifts interior points, changes
+//    connectivity or inserts interior points so that fewer curved elements are invalid, accepting
+//    new tets down to min(1 degree, the worst they replace); polish(below) then raises the tets
+//    below `below` degrees, never lowering the worst tet a change replaces and never making more
+//    curved elements invalid than it removes, so it never lowers the mesh's worst angle.
+//  * After either the linear mesh is valid (mesh_check.h), covers the same region and has the
+//    same boundary: input points, boundary points and the surface never move.
+//  * element_ok needs prepare_check() (lift calls it) after the last change of the boundary;
+//    hook results are cached per boundary edge (boundary points never move).
+//  * Deterministic: tets worst first or in index order, candidates in a fixed order.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+
+#include "bsptet/mesh/types.h"
+#include "bsptet/refine/mesh_optimizer.h"
+#include "bsptet/refine/quality_refine.h"
+#include "bsptet/refine/refine_mesh.h"
+#include "bsptet/refine/target_sizes.h"
+
+namespace bsptet {
+
+class CurvedRoom {
+ public:
+  CurvedRoom(RefineMesh& m, const RefineOptions& o, RefineStats& st, TargetSizes& size, MeshOptimizer& opt)
+      : m_(m), o_(o), st_(st), size_(size), opt_(opt) {}
+
+  /// Makes the invalid curved elements valid where it can (see the contract); sets
+  /// RefineStats::curving_conflicts_left, counts curving_lifts.
+  void lift();
+  /// Flips, moves, collapses and insertions around the tets below `below` degrees (see the
+  /// contract); returns the changes made.
+  std::int64_t polish(double below);
+
+  /// The tags of each boundary edge's faces, for the hook; call once the surface is final.
+  void prepare_check();
+  /// True when the curved element of corners q at positions P is valid (see above).
+  bool element_ok(const std::array<Index, 4>& q, const std::array<Vec3, 4>& P);
+
+ private:
+  bool insert_keeping_curved(Index t);
+  bool move_keeping_curved(Index v);
+  template <class CurvedOk, class Corners>
+  bool reconnect_for_curving(Index t, const CurvedOk& curved_ok, const Corners& corners);
+
+  RefineMesh& m_;
+  const RefineOptions& o_;
+  RefineStats& st_;
+  TargetSizes& size_;
+  MeshOptimizer& opt_;
+  std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> edge_tags_;  // prepare_check
+  std::map<std::array<Index, 2>, Vec3> projected_;  // hook results at boundary edge midpoints
+};
+
+}  // namespace bsptet
