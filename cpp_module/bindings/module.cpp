@@ -146,7 +146,7 @@ MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effor
 }
 
 // The statistics dicts, built from the schemas (core/mesher.h for_each_mesh_stat, fem/fem_mesh.h
-// for_each_fem_stat).
+// for_each_fem_stat; refine/quality_refine.h for_each_refine_stat where refine_quality is bound).
 py::dict mesh_stats_dict(const MeshStats& st) {
   py::dict d;
   for_each_mesh_stat([&](const char* key, auto member) { d[key] = st.*member; });
@@ -401,35 +401,7 @@ PYBIND11_MODULE(_bsptet, m) {
         RefineStats st;
         run_without_gil(o, progress, cancel, [&]() { out = refine_quality(s, mesh, o, &st); });
         py::dict d;
-        d["points"] = st.points;
-        d["tets"] = st.tets;
-        d["nodes"] = st.nodes;
-        d["splits"] = st.splits;
-        d["surface_splits"] = st.surface_splits;
-        d["splits_no_exact_point"] = st.splits_no_exact_point;
-        d["splits_rejected"] = st.splits_rejected;
-        d["projection_rejected"] = st.projection_rejected;
-        d["collapses"] = st.collapses;
-        d["flips23"] = st.flips23;
-        d["flips32"] = st.flips32;
-        d["edge_removals"] = st.edge_removals;
-        d["relocations"] = st.relocations;
-        d["insertions"] = st.insertions;
-        d["size_passes"] = st.size_passes;
-        d["optimize_rounds"] = st.optimize_rounds;
-        d["long_edges_left"] = st.long_edges_left;
-        d["tag_splits"] = st.tag_splits;
-        d["tag_conflicts_left"] = st.tag_conflicts_left;
-        d["midnodes_projected"] = st.midnodes_projected;
-        d["midnodes_straightened"] = st.midnodes_straightened;
-        d["curving_lifts"] = st.curving_lifts;
-        d["curving_conflicts_left"] = st.curving_conflicts_left;
-        d["midnodes_relaxed_tets"] = st.midnodes_relaxed_tets;
-        d["midnodes_moved_interior"] = st.midnodes_moved_interior;
-        d["midnodes_moved_surface"] = st.midnodes_moved_surface;
-        d["lift_insertions"] = st.lift_insertions;
-        d["seconds"] = st.seconds;
-        d["seconds_by_pass"] = st.seconds_by_pass;
+        for_each_refine_stat([&](const char* key, auto member) { d[key] = st.*member; });
         return py::make_tuple(points_array(out), tets_array(out), d);
       },
       py::arg("surface_points"), py::arg("surface_triangles"), py::arg("surface_tags"), py::arg("points"),

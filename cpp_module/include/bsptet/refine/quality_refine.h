@@ -170,6 +170,47 @@ struct RefineStats {
   std::map<std::string, double> seconds_by_pass;
 };
 
+/// The statistics schema, stated once: calls f(key, member pointer) for every figure of
+/// RefineStats; the keys are those of the statistics JSON.
+template <class F>
+void for_each_refine_stat(F&& f) {
+  f("points", &RefineStats::points);
+  f("tets", &RefineStats::tets);
+  f("nodes", &RefineStats::nodes);
+  f("splits", &RefineStats::splits);
+  f("surface_splits", &RefineStats::surface_splits);
+  f("splits_no_exact_point", &RefineStats::splits_no_exact_point);
+  f("splits_rejected", &RefineStats::splits_rejected);
+  f("projection_rejected", &RefineStats::projection_rejected);
+  f("splits_fixed_surface", &RefineStats::splits_fixed_surface);
+  f("collapses", &RefineStats::collapses);
+  f("flat_collapses", &RefineStats::flat_collapses);
+  f("flips23", &RefineStats::flips23);
+  f("flips32", &RefineStats::flips32);
+  f("edge_removals", &RefineStats::edge_removals);
+  f("relocations", &RefineStats::relocations);
+  f("insertions", &RefineStats::insertions);
+  f("refinement_points", &RefineStats::refinement_points);
+  f("size_passes", &RefineStats::size_passes);
+  f("optimize_rounds", &RefineStats::optimize_rounds);
+  f("long_edges_left", &RefineStats::long_edges_left);
+  f("tag_splits", &RefineStats::tag_splits);
+  f("tag_conflicts_left", &RefineStats::tag_conflicts_left);
+  f("midnodes_projected", &RefineStats::midnodes_projected);
+  f("midnodes_straightened", &RefineStats::midnodes_straightened);
+  f("curving_lifts", &RefineStats::curving_lifts);
+  f("curving_conflicts_left", &RefineStats::curving_conflicts_left);
+  f("midnodes_relaxed_tets", &RefineStats::midnodes_relaxed_tets);
+  f("midnodes_moved_interior", &RefineStats::midnodes_moved_interior);
+  f("midnodes_moved_surface", &RefineStats::midnodes_moved_surface);
+  f("lift_insertions", &RefineStats::lift_insertions);
+  f("worst_deg_optimized", &RefineStats::worst_deg_optimized);
+  f("worst_deg_curving_room", &RefineStats::worst_deg_curving_room);
+  f("worst_deg", &RefineStats::worst_deg);
+  f("seconds", &RefineStats::seconds);
+  f("seconds_by_pass", &RefineStats::seconds_by_pass);
+}
+
 /// Refines and optimizes `mesh`, a valid linear tet mesh of `surface`. Throws InputError for bad
 /// options (naming the option), MeshingError otherwise (code kCancelled when cancelled).
 /// `boundary` (optional) receives the result's boundary faces (faces of one tet), oriented outward,
