@@ -28,7 +28,7 @@ from ..kernel import core
 from ..kernel.freecad_env import import_freecad
 from ..kernel.mesh_types import Surface, TetMesh
 from ..peers.gmsh import gmsh_available, gmsh_cad_command, run_gmsh_cad
-from ..peers.netgen import netgen_available, netgen_command, run_netgen, NGOCC_EXTENSIONS
+from ..peers.netgen import netgen_command, NetgenMissing, NGOCC_EXTENSIONS, run_netgen
 from ..peers.tetgen import quality_switches, run_tetgen, tetgen_available
 
 #: Seconds each peer may take.
@@ -106,11 +106,11 @@ def gmsh_row(cad_path, size, order, timeout=PEER_TIMEOUT):
 
 def netgen_row(cad_path, size, order, timeout=PEER_TIMEOUT):
     command = netgen_command(size, order)
-    if not netgen_available():
-        return SizeRow(NETGEN, command, "skipped", "Netgen's Python module is not installed "
-                       "(Debian package python3-netgen)")
     try:
         run = run_netgen(cad_path, size, order, timeout=timeout)
+    except NetgenMissing:
+        return SizeRow(NETGEN, command, "skipped", "Netgen's Python module is not installed "
+                       "(Debian package python3-netgen)")
     except Exception as e:  # noqa: BLE001
         return SizeRow(NETGEN, command, "failed", str(e)[:300])
     return measured_row(NETGEN, command, run.points, run.tets, run.seconds)

@@ -119,6 +119,22 @@ def restore_input_points(mesh: TetMesh, surface: Surface) -> int:
     return changed
 
 
+def _run_and_read(argv, out, timeout, workdir):
+    """Runs gmsh (``argv``, writing ``out``) and reads its tets: ``(run, mesh)``. Raises
+    InternalError when it times out, fails, reports an error or makes no tets."""
+    run = run_measured(argv, timeout=timeout, cwd=workdir)
+    if run.timed_out:
+        raise InternalError(f"gmsh timed out after {timeout:g} s")
+    errors = [ln for ln in run.output.splitlines() if ln.startswith("Error")]
+    if run.returncode != 0 or errors or not os.path.exists(out):
+        raise InternalError(f"gmsh failed (exit {run.returncode}): "
+                            + ("; ".join(errors[:3]) or run.tail()))
+    mesh = read_tet_mesh(out)
+    if len(mesh.tets) == 0:
+        raise InternalError("gmsh made no tetrahedra: " + run.tail())
+    return run, mesh
+
+
 def gmsh_command(size, remesh_surface=False):
     return (f"gmsh -3 ({'surface remeshed, ' if remesh_surface else ''}"
             f"CharacteristicLengthMax {size:.4g})")
@@ -144,17 +160,8 @@ def run_gmsh(surface: Surface, size: float, timeout=None, keep_dir=None, name="s
         geo = os.path.join(workdir, name + ".geo")
         _write_geo(geo, msh_in, float(size), remesh_surface)
         out = os.path.join(workdir, name + ".gmsh.msh")
-        run = run_measured([exe, geo, "-3", "-nt", "1", "-format", "msh22", "-o", out],
-                           timeout=timeout, cwd=workdir)
-        if run.timed_out:
-            raise InternalError(f"gmsh timed out after {timeout:g} s")
-        errors = [ln for ln in run.output.splitlines() if ln.startswith("Error")]
-        if run.returncode != 0 or errors or not os.path.exists(out):
-            raise InternalError(f"gmsh failed (exit {run.returncode}): "
-                                + ("; ".join(errors[:3]) or run.tail()))
-        mesh = read_tet_mesh(out)
-        if len(mesh.tets) == 0:
-            raise InternalError("gmsh made no tetrahedra: " + run.tail())
+        run, mesh = _run_and_read([exe, geo, "-3", "-nt", "1", "-format", "msh22", "-o", out],
+                                  out, timeout, workdir)
         restore_input_points(mesh, surface)
         return GmshResult(mesh=mesh, command=gmsh_command(size, remesh_surface),
                           seconds=run.seconds,
@@ -179,18 +186,9 @@ def run_gmsh_cad(part, size, order=2, timeout=None, keep_dir=None, name="part") 
     workdir = keep_dir or tempfile.mkdtemp(prefix="fembsptet_gmsh_")
     try:
         out = os.path.join(workdir, name + ".gmsh.msh")
-        run = run_measured([exe, os.path.abspath(part), "-3", "-clmax", repr(float(size)),
-                            "-order", str(int(order)), "-nt", "1", "-format", "msh22",
-                            "-o", out], timeout=timeout, cwd=workdir)
-        if run.timed_out:
-            raise InternalError(f"gmsh timed out after {timeout:g} s")
-        errors = [ln for ln in run.output.splitlines() if ln.startswith("Error")]
-        if run.returncode != 0 or errors or not os.path.exists(out):
-            raise InternalError(f"gmsh failed (exit {run.returncode}): "
-                                + ("; ".join(errors[:3]) or run.tail()))
-        mesh = read_tet_mesh(out)
-        if len(mesh.tets) == 0:
-            raise InternalError("gmsh made no tetrahedra: " + run.tail())
+        run, mesh = _run_and_read([exe, os.path.abspath(part), "-3", "-clmax", repr(float(size)),
+                                   "-order", str(int(order)), "-nt", "1", "-format", "msh22",
+                                   "-o", out], out, timeout, workdir)
         return GmshResult(mesh=mesh, command=gmsh_cad_command(size, order), seconds=run.seconds,
                           peak_rss_mb=run.peak_rss_mb, output=run.output, mesh_path=out)
     finally:

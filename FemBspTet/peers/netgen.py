@@ -40,6 +40,8 @@ from .process import DEFAULT_TIMEOUT, run_measured, worker_env
 NETGEN_TO_VTK_TET10 = np.array([0, 1, 2, 3, 4, 7, 5, 6, 8, 9])
 #: Interpreter of the Netgen process: Debian's, where ``python3-netgen`` is installed.
 NETGEN_PYTHON = "/usr/bin/python3"
+#: Exit code of the Netgen process when its interpreter has no Netgen module.
+MISSING_EXIT = 3
 #: Files Netgen 6.2.1905 reads itself; other CAD files go through STEP.
 NGOCC_EXTENSIONS = (".step", ".stp", ".iges", ".igs")
 
@@ -54,14 +56,8 @@ class NetgenResult:
     command: str
 
 
-def netgen_available(python=NETGEN_PYTHON):
-    """True if ``python`` can import Netgen's Python module (Debian package ``python3-netgen``)."""
-    if not os.path.isfile(python):
-        return False
-    if os.path.realpath(python) == os.path.realpath(sys.executable):
-        return importlib.util.find_spec("netgen") is not None
-    run = run_measured([python, "-c", "import netgen.meshing"], timeout=60)
-    return run.returncode == 0
+class NetgenMissing(RuntimeError):
+    """The interpreter has no Netgen Python module (Debian package python3-netgen)."""
 
 
 def netgen_command(h, order):
@@ -70,7 +66,9 @@ def netgen_command(h, order):
 
 def run_netgen(part, h, order=2, timeout=DEFAULT_TIMEOUT, python=NETGEN_PYTHON, workdir=None):
     """Netgen on the CAD file ``part`` (STEP, IGES; BREP on Netgen 6.2.2 and later) at
-    ``maxh = h``. Raises RuntimeError with Netgen's last words when it fails or times out."""
+    ``maxh = h``. Raises NetgenMissing when ``python`` has no Netgen module (the process says
+    so itself: no second process to find out), RuntimeError with Netgen's last words when it
+    fails or times out."""
     own_dir = workdir is None
     workdir = workdir or tempfile.mkdtemp(prefix="fembsptet_netgen_")
     out = os.path.join(workdir, "netgen_mesh.npz")
@@ -80,6 +78,9 @@ def run_netgen(part, h, order=2, timeout=DEFAULT_TIMEOUT, python=NETGEN_PYTHON, 
                            env=worker_env())
         if run.timed_out:
             raise RuntimeError("netgen timed out after %g s" % timeout)
+        if run.returncode == MISSING_EXIT:
+            raise NetgenMissing("%s has no Netgen module (Debian package python3-netgen)"
+                                % python)
         if run.returncode != 0 or not os.path.isfile(out):
             raise RuntimeError("netgen failed (exit %s): %s" % (run.returncode, run.tail()))
         with np.load(out, allow_pickle=False) as z:
@@ -168,6 +169,8 @@ def main(argv=None):
         print("usage: python3 -m FemBspTet.peers.netgen PART H ORDER OUT.npz", file=sys.stderr)
         return 2
     part, h, order, out = argv[0], float(argv[1]), int(argv[2]), argv[3]
+    if importlib.util.find_spec("netgen") is None:
+        return MISSING_EXIT
     points, tets, seconds, _ = mesh_with_netgen(part, h, order)
     np.savez(out, points=points, tets=tets, seconds=np.float64(seconds))
     return 0
