@@ -2,8 +2,9 @@
 """Progress of a command-line run on stderr, by stage; silent for runs shorter than a second.
 
 ``Progress(enabled=True)`` is called with ``(stage, fraction)`` (fraction in 0..1 or None when
-the stage cannot tell). Within a stage the shown fraction never goes back; a new stage starts
-at 0.
+the stage cannot tell). A stage's shown fraction never goes back, also when the stage comes
+again after others (the bar redraws ten times a second, so a short stage in between may never
+be seen: the same name must not show a smaller percentage); a new stage starts at 0.
 
 * stderr is a terminal: one line that fits the terminal's width, drawn by ``rich`` (Debian's
   ``python3-rich``): the stage's name, a bar and its percentage, the elapsed seconds. It appears
@@ -27,6 +28,7 @@ class Progress:
         self.start = time.monotonic()
         self.stage = ""
         self.fraction = 0.0
+        self._reached = {}  # stage -> largest fraction reported for it
         self._shown_stage = None
         try:
             self._terminal = bool(self.stream.isatty())
@@ -37,9 +39,10 @@ class Progress:
 
     def __call__(self, stage, fraction=None):
         if stage != self.stage:
-            self.stage, self.fraction = stage, 0.0
+            self.stage, self.fraction = stage, self._reached.get(stage, 0.0)
         if fraction is not None:
             self.fraction = max(self.fraction, min(max(float(fraction), 0.0), 1.0))
+        self._reached[stage] = self.fraction
         if not self.enabled:
             return
         elapsed = time.monotonic() - self.start
