@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <string>
@@ -100,7 +101,7 @@ py::array_t<std::int64_t> tets_array(const TetMesh& m) {
 // MeshingError (code "cancelled"). Options: MeshOptions or RefineOptions.
 template <class Options, class Run>
 void run_without_gil(Options& o, const py::object& progress, const py::object& cancel, Run&& run) {
-  bool interrupted = false;
+  std::atomic<bool> interrupted{false};  // set from whichever thread polls (out_of_core.h workers)
   o.cancelled = [&]() {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) {
@@ -284,12 +285,13 @@ PYBIND11_MODULE(_bsptet, m) {
       "tetrahedralize_in_pieces",
       [](const DoubleArray& points, const IndexArray& triangles, const std::string& stem,
          std::int64_t max_piece_triangles, py::object progress, py::object cancel, std::int64_t steiner_effort,
-         const std::string& bsp_seed, bool check_pieces) {
+         const std::string& bsp_seed, bool check_pieces, int workers) {
         const SurfaceMesh s = surface_from(points, triangles);
         MeshOptions o = core_options(bsp_seed, steiner_effort);
         PieceOptions po;
         po.max_piece_triangles = max_piece_triangles;
         po.check_pieces = check_pieces;
+        po.workers = workers;
         PieceStats ps;
         run_without_gil(o, progress, cancel, [&]() { tetrahedralize_in_pieces(s, o, po, stem, &ps); });
         py::dict d;
@@ -313,10 +315,63 @@ PYBIND11_MODULE(_bsptet, m) {
       py::arg("points"), py::arg("triangles"), py::arg("stem"), py::arg("max_piece_triangles"),
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
       py::arg("steiner_effort") = MeshOptions{}.steiner_effort, py::arg("bsp_seed") = "auto",
-      py::arg("check_pieces") = true,
+      py::arg("check_pieces") = true, py::arg("workers") = 1,
       "Meshes the solid bounded by a checked closed surface in pieces of at most max_piece_triangles "
-      "triangles, one after the other, streaming the mesh to stem.node / stem.ele (see out_of_core.h). "
-      "Returns a stats dict. Raises InputError or MeshingError; nothing is written then.");
+      "triangles, `workers` of them at a time on threads, streaming the mesh to stem.node / stem.ele "
+      "(see out_of_core.h; the same mesh for every `workers`). Returns a stats dict. Raises InputError "
+      "or MeshingError; nothing is written then.");
+
+  // The steps of tetrahedralize_in_pieces, for engines that mesh the pieces elsewhere.
+  m.def(
+      "cut_into_pieces",
+      [](const DoubleArray& points, const IndexArray& triangles, std::int64_t max_piece_triangles, py::object cancel,
+         int workers) {
+        const SurfaceMesh s = surface_from(points, triangles);
+        MeshOptions o;
+        PieceOptions po;
+        po.max_piece_triangles = max_piece_triangles;
+        po.workers = workers;
+        PieceStats ps;
+        SolidPieces solid;
+        run_without_gil(o, py::none(), cancel, [&]() { solid = cut_into_pieces(s, o, po, &ps); });
+        py::array_t<double> xyz({static_cast<py::ssize_t>(solid.xyz.size() / 3), static_cast<py::ssize_t>(3)});
+        std::copy(solid.xyz.begin(), solid.xyz.end(), xyz.mutable_data());
+        py::list pieces;
+        for (const auto& piece : solid.pieces) {
+          py::array_t<std::int64_t> a({static_cast<py::ssize_t>(piece.size() / 3), static_cast<py::ssize_t>(3)});
+          std::copy(piece.begin(), piece.end(), a.mutable_data());
+          pieces.append(a);
+        }
+        py::dict d;
+        d["pieces"] = ps.pieces;
+        d["cuts"] = ps.cuts;
+        d["cuts_refused"] = ps.cuts_refused;
+        d["cap_triangles"] = ps.cap_triangles;
+        d["cap_points"] = ps.cap_points;
+        d["largest_piece_triangles"] = ps.largest_piece_triangles;
+        d["max_piece_triangles"] = max_piece_triangles;
+        d["seconds_cutting"] = ps.seconds_cutting;
+        d["uncut"] = ps.uncut;
+        return py::make_tuple(xyz, pieces, d);
+      },
+      py::arg("points"), py::arg("triangles"), py::arg("max_piece_triangles"), py::arg("cancel") = py::none(),
+      py::arg("workers") = 1,
+      "Step 1 of tetrahedralize_in_pieces (out_of_core.h cut_into_pieces): returns (xyz, pieces, stats), "
+      "xyz the input points then the caps' own points, pieces a list of (k, 3) triangle arrays over xyz.");
+  m.def(
+      "mesh_piece",
+      [](const DoubleArray& points, const IndexArray& triangles, const std::string& name, bool check,
+         std::int64_t steiner_effort, const std::string& bsp_seed) {
+        const SurfaceMesh s = surface_from(points, triangles);
+        MeshOptions o = core_options(bsp_seed, steiner_effort);
+        TetMesh mesh;
+        run_without_gil(o, py::none(), py::none(), [&]() { mesh = mesh_piece(s, o, check, name); });
+        return py::make_tuple(points_array(mesh), tets_array(mesh));
+      },
+      py::arg("points"), py::arg("triangles"), py::arg("name"), py::arg("check") = true,
+      py::arg("steiner_effort") = MeshOptions{}.steiner_effort, py::arg("bsp_seed") = "auto",
+      "Step 2 of tetrahedralize_in_pieces (out_of_core.h mesh_piece) on a piece's own surface: returns "
+      "(points, tets), the piece's points first, then its Steiner points; checked exactly with check.");
 
   m.def("piece_triangles_for_budget", &piece_triangles_for_budget, py::arg("budget_bytes"),
         "The largest piece (triangles) the out-of-core mode's estimate fits in budget_bytes (out_of_core.h).");

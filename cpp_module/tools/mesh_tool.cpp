@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: %s SURFACE.off [--allow-boundary-steiner] [--debug-checks] [--cone-cells] [--seed auto|delaunay|box] [--along-lines] [--bsp-shift K] [--steiner-effort N] [--reorient] "
-                 "[--progress] [--no-check] [--write STEM] [--pieces N | --max-piece-triangles K | --max-memory SIZE]\n",
+                 "[--progress] [--no-check] [--write STEM] [--pieces N | --max-piece-triangles K | --max-memory SIZE] [--workers W]\n",
                  argv[0]);
     return 2;
   }
@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
   std::string stem;
   bool no_check = false;
   long long pieces = 0, piece_triangles = 0, max_memory = 0;  // the out-of-core mode when any is set
+  int workers = 1;                                             // pieces meshed at once
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--allow-boundary-steiner")) o.allow_boundary_steiner = true;
     else if (!std::strcmp(argv[i], "--debug-checks")) o.debug_checks = true;
@@ -112,6 +113,7 @@ int main(int argc, char** argv) {
       };
     else if (!std::strcmp(argv[i], "--write") && i + 1 < argc) stem = argv[++i];
     else if (!std::strcmp(argv[i], "--pieces") && i + 1 < argc) pieces = std::strtoll(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--workers") && i + 1 < argc) workers = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-piece-triangles") && i + 1 < argc) piece_triangles = std::strtoll(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--max-memory") && i + 1 < argc) {
       max_memory = parse_size(argv[++i]);
@@ -133,9 +135,9 @@ int main(int argc, char** argv) {
     const double read_s = since(t0);
     // The surface check's self-intersection search runs beside the core (check_and_tetrahedralize);
     // "check beyond the core" below: the rest of the check, done first, and any wait for the search.
-    if (pieces > 0 || piece_triangles > 0 || max_memory > 0) {
+    if (pieces > 0 || piece_triangles > 0 || max_memory > 0 || workers > 1) {
       if (stem.empty()) {
-        std::fprintf(stderr, "--pieces, --max-piece-triangles and --max-memory write the mesh as they go: give --write STEM\n");
+        std::fprintf(stderr, "--pieces, --max-piece-triangles, --max-memory and --workers write the mesh as they go: give --write STEM\n");
         return 2;
       }
       t0 = Clock::now();
@@ -143,9 +145,11 @@ int main(int argc, char** argv) {
       const double check_s = since(t0);
       PieceOptions po;
       po.check_pieces = !no_check;
+      po.workers = workers;
       po.max_piece_triangles = piece_triangles > 0 ? piece_triangles
                                : pieces > 0       ? (s.num_triangles() + pieces - 1) / pieces
-                                                  : piece_triangles_for_budget(max_memory);
+                               : max_memory > 0   ? piece_triangles_for_budget(max_memory)
+                                                  : piece_triangles_for_workers(s.num_triangles(), workers);
       if (o.progress) po.log = [](const std::string& line) { std::fprintf(stderr, "[%s]\n", line.c_str()); };
       PieceStats ps;
       tetrahedralize_in_pieces(s, o, po, stem, &ps);

@@ -7,7 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <condition_variable>
+#include <exception>
+#include <future>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "bsptet/numerics/errors.h"
 #include "bsptet/mesh/mesh_check.h"
@@ -16,20 +21,8 @@
 #include "bsptet/input/surface_check.h"
 
 namespace bsptet {
-namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-constexpr std::int64_t kBaseBytes = 32LL << 20;
-constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
-constexpr int kRepairRounds = 8;
-constexpr double kCapEdgeWeight = 3.0;
-constexpr std::int64_t kMaxRepairPairs = 100000;
-
-// A piece's own surface: the input vertices its triangles use (ascending input ids, returned in
-// `globals`) and its triangles over them.
-SurfaceMesh local_surface(const std::vector<double>& points, const std::vector<Index>& tri, std::vector<Index>& globals) {
+SurfaceMesh piece_surface(const std::vector<double>& points, const std::vector<Index>& tri, std::vector<Index>& globals) {
   globals.assign(tri.begin(), tri.end());
   std::sort(globals.begin(), globals.end());
   globals.erase(std::unique(globals.begin(), globals.end()), globals.end());
@@ -42,11 +35,27 @@ SurfaceMesh local_surface(const std::vector<double>& points, const std::vector<I
   return s;
 }
 
-// Empty when check_surface accepts the piece as it is, else its message.
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr std::int64_t kBaseBytes = 32LL << 20;
+constexpr std::int64_t kBytesPerTriangle = 2LL << 10;
+constexpr int kRepairRounds = 8;
+constexpr double kCapEdgeWeight = 3.0;
+constexpr std::int64_t kMaxRepairPairs = 100000;
+
+// Empty when check_surface accepts the piece as it is, but for its self-intersection search,
+// else its message. That search is cap_crossings': a piece's triangles other than its new caps'
+// are its parent's, which do not cross each other (the parent was checked), so the pairs to look
+// at are those with a cap triangle, and both of those meet the caps' box.
 std::string surface_problem(const std::vector<double>& points, const std::vector<Index>& tri) {
   std::vector<Index> globals;
+  SurfaceCheckOptions options;
+  options.self_intersections = false;
   try {
-    check_surface(local_surface(points, tri, globals));
+    check_surface(piece_surface(points, tri, globals), options);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -55,9 +64,10 @@ std::string surface_problem(const std::vector<double>& points, const std::vector
 
 // The surface triangles of a piece (source >= 0) that a cap triangle of it (source < 0) crosses,
 // by the exact search of self_intersection.h on the caps and the triangles whose boxes meet the
-// caps' box. Only to steer the repairs: the piece is then checked whole.
+// caps' box; `caps_cross` is set when two cap triangles cross each other (or the search was cut
+// short). Nothing found and nothing set: no triangle pair with a cap triangle intersects.
 std::vector<Index> cap_crossings(const std::vector<double>& points, const std::vector<Index>& piece,
-                                 const std::vector<Index>& source) {
+                                 const std::vector<Index>& source, bool& caps_cross) {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (std::size_t t = 0; t < source.size(); ++t)
     if (source[t] < 0)
@@ -83,21 +93,38 @@ std::vector<Index> cap_crossings(const std::vector<double>& points, const std::v
   }
   std::vector<Index> globals;
   std::vector<Index> crossed;
-  for (const auto& pair : find_self_intersections(local_surface(points, near, globals), kMaxRepairPairs)) {
+  bool complete = true;
+  for (const auto& pair : find_self_intersections(piece_surface(points, near, globals), kMaxRepairPairs, &complete)) {
     const Index a = source[from[pair[0]]], b = source[from[pair[1]]];
     if ((a < 0) != (b < 0)) crossed.push_back(a < 0 ? b : a);
+    caps_cross = caps_cross || (a < 0 && b < 0);
   }
+  caps_cross = caps_cross || !complete;
   return crossed;
+}
+
+// Runs f and g, on two threads when `parallel` (neither may touch what the other writes).
+template <class F, class G>
+void both(bool parallel, F&& f, G&& g) {
+  if (!parallel) {
+    f();
+    g();
+    return;
+  }
+  auto later = std::async(std::launch::async, std::forward<G>(g));
+  f();
+  later.get();
 }
 
 // Cuts the piece `tri` in two (below, above) by the first cut that solid_cut makes and that
 // check_surface accepts on both sides (candidates below; points from first_cap_point on are
 // earlier caps'). Where a cap crosses a surface
 // triangle, the triangles around that triangle's vertices are moved to the other side and the
-// cut made again (at most kRepairRounds times). False when no cut works.
+// cut made again (at most kRepairRounds times). False when no cut works. With `parallel`, the
+// two sides are searched and checked on two threads.
 bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::vector<Index>& tri,
                std::vector<Index>& below, std::vector<Index>& above, PieceStats& st,
-               const std::function<void(const std::string&)>& log) {
+               const std::function<void(const std::string&)>& log, bool parallel) {
   const std::size_t n = tri.size() / 3;
   // Candidate cuts: across each axis at the quantiles 0.3, 0.35, ..., 0.7 of the triangles'
   // corner sums.
@@ -161,23 +188,32 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
       const std::size_t old_size = points.size();
       points.insert(points.end(), cut.new_points.begin(), cut.new_points.end());  // dropped if refused
       // Repair where a cap crosses a surface triangle (found near the caps only), then check both
-      // pieces whole.
+      // pieces' topology and orientation whole (surface_problem).
       std::size_t crossings = 0;
-      for (int side = 1; side >= 0; --side) {
-        const std::vector<Index>& source = side ? cut.below_source : cut.above_source;
-        for (Index t : cap_crossings(points, side ? cut.below : cut.above, source)) {
+      std::vector<Index> crossed[2];  // [0] above, [1] below
+      bool caps_cross[2] = {false, false};
+      both(parallel, [&] { crossed[1] = cap_crossings(points, cut.below, cut.below_source, caps_cross[1]); },
+           [&] { crossed[0] = cap_crossings(points, cut.above, cut.above_source, caps_cross[0]); });
+      for (int side = 1; side >= 0; --side)
+        for (Index t : crossed[side]) {
           ++crossings;
           for (int k = 0; k < 3; ++k) forced.emplace_back(tri[3 * static_cast<std::size_t>(t) + k], static_cast<char>(!side));
         }
-      }
       if (crossings > 0) {
         points.resize(old_size);
         if (round == kRepairRounds) why = std::to_string(crossings) + " surface triangles still cross its caps after " +
                                           std::to_string(kRepairRounds) + " repairs";
         continue;
       }
-      why = surface_problem(points, cut.below);
-      if (why.empty()) why = surface_problem(points, cut.above);
+      if (caps_cross[0] || caps_cross[1]) {
+        points.resize(old_size);
+        why = "its cap triangles cross each other";
+        break;
+      }
+      std::string why_above;
+      both(parallel, [&] { why = surface_problem(points, cut.below); },
+           [&] { why_above = surface_problem(points, cut.above); });
+      if (why.empty()) why = why_above;
       if (!why.empty()) {
         points.resize(old_size);
         break;
@@ -236,106 +272,211 @@ std::int64_t piece_triangles_for_budget(std::int64_t budget_bytes) {
   return std::max<std::int64_t>(1000, (budget_bytes - kBaseBytes) / kBytesPerTriangle);
 }
 
-void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& options, const PieceOptions& po,
-                              const std::string& stem, PieceStats* stats) {
-  if (options.allow_boundary_steiner)
-    throw InputError(ErrorCode::kBadArgument, "pieces", -1,
-                     "the out-of-core mode needs the default allow_boundary_steiner = false: its pieces must meet "
-                     "in exactly their caps' triangles");
-  PieceStats st;
-  auto check_cancel = [&] {
-    if (options.cancelled && options.cancelled())
-      throw MeshingError(ErrorCode::kCancelled, "pieces", -1, "cancelled");
-  };
+std::int64_t piece_triangles_for_workers(std::int64_t triangles, int workers) {
+  if (workers <= 1) return 0;
+  return (5 * triangles + 4 * workers - 1) / (4 * workers);
+}
 
-  // 1. Cut until every piece is small enough (depth first, below before above: deterministic).
-  auto t0 = Clock::now();
-  std::vector<std::vector<Index>> todo{surface.tri}, pieces;
-  std::vector<double> points = surface.xyz;  // the input's, then the caps' own
+SolidPieces cut_into_pieces(const SurfaceMesh& surface, const MeshOptions& options, const PieceOptions& po,
+                            PieceStats* stats) {
+  PieceStats local_stats;
+  PieceStats& st = stats ? *stats : local_stats;
+  // Depth first, below before above: deterministic.
+  const auto t0 = Clock::now();
+  SolidPieces solid;
+  solid.xyz = surface.xyz;
+  solid.input_points = surface.num_points();
+  std::vector<std::vector<Index>> todo{surface.tri};
   while (!todo.empty()) {
     std::vector<Index> tri = std::move(todo.back());
     todo.pop_back();
     const std::int64_t n = static_cast<std::int64_t>(tri.size() / 3);
     if (po.max_piece_triangles <= 0 || n <= po.max_piece_triangles || n <= po.min_piece_triangles) {
-      pieces.push_back(std::move(tri));
+      solid.pieces.push_back(std::move(tri));
       continue;
     }
-    check_cancel();
+    if (options.cancelled && options.cancelled()) throw MeshingError(ErrorCode::kCancelled, "pieces", -1, "cancelled");
     if (options.progress) options.progress("cutting into pieces", 0);
     std::vector<Index> below, above;
     const std::size_t refused_before = st.refused.size();
-    if (!cut_piece(points, surface.num_points(), tri, below, above, st, po.log)) {
+    if (!cut_piece(solid.xyz, solid.input_points, tri, below, above, st, po.log, po.workers > 1)) {
       std::string reasons;
       for (std::size_t i = std::max(refused_before, st.refused.size() >= 3 ? st.refused.size() - 3 : 0); i < st.refused.size(); ++i)
         reasons += "\n  " + st.refused[i];
       st.uncut.push_back("a piece of " + std::to_string(n) + " triangles could not be cut (every cut tried was refused; the last ones:" +
                          reasons + "\n): it is meshed whole");
       if (po.log) po.log(st.uncut.back());
-      pieces.push_back(std::move(tri));
+      solid.pieces.push_back(std::move(tri));
       continue;
     }
     todo.push_back(std::move(above));
     todo.push_back(std::move(below));
   }
-  st.pieces = static_cast<std::int64_t>(pieces.size());
-  for (const auto& p : pieces) st.largest_piece_triangles = std::max<std::int64_t>(st.largest_piece_triangles, p.size() / 3);
+  st.pieces = static_cast<std::int64_t>(solid.pieces.size());
+  for (const auto& p : solid.pieces) st.largest_piece_triangles = std::max<std::int64_t>(st.largest_piece_triangles, p.size() / 3);
   st.seconds_cutting = since(t0);
+  return solid;
+}
 
-  // 2. Output numbering: the used input points in input order, the caps' points, then the
-  // pieces' Steiner points.
-  std::vector<Index> out_id(points.size() / 3, -1);
-  for (Index v : surface.tri) out_id[v] = 0;
-  for (std::size_t v = surface.xyz.size() / 3; v < out_id.size(); ++v) out_id[v] = 0;
+TetMesh mesh_piece(const SurfaceMesh& piece, const MeshOptions& options, bool check, const std::string& name,
+                   MeshStats* stats) {
+  TetMesh m = tetrahedralize(piece, options, stats);
+  if (m.num_points() < piece.num_points() || !std::equal(piece.xyz.begin(), piece.xyz.end(), m.xyz.begin()))
+    throw MeshingError(ErrorCode::kInternal, "pieces", -1, name + ": the core did not put the piece's input points first");
+  if (check) {
+    MeshCheckOptions co;
+    co.compute_quality = false;
+    co.max_messages = 3;
+    const MeshCheckReport r = check_mesh(piece, m, co);
+    if (!r.valid) {
+      std::string msg = name + ": its mesh failed the exact check";
+      for (const auto& s : r.messages) msg += "; " + s;
+      throw MeshingError(ErrorCode::kInternal, "pieces", -1, msg);
+    }
+  }
+  return m;
+}
+
+std::vector<Index> merged_point_ids(const SolidPieces& solid) {
+  std::vector<Index> out_id(solid.xyz.size() / 3, -1);
+  for (const auto& piece : solid.pieces)
+    for (Index v : piece) out_id[v] = 0;
+  for (std::size_t v = static_cast<std::size_t>(solid.input_points); v < out_id.size(); ++v) out_id[v] = 0;
   Index used = 0;
   for (Index& id : out_id)
     if (id == 0) id = used++;
+  return out_id;
+}
 
-  // 3. Mesh the pieces one after the other, spooling their Steiner points and tets.
+void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& options, const PieceOptions& po,
+                              const std::string& stem, PieceStats* stats) {
+  if (options.allow_boundary_steiner)
+    throw InputError(ErrorCode::kBadArgument, "pieces", -1,
+                     "the out-of-core mode needs the default allow_boundary_steiner = false: its pieces must meet "
+                     "in exactly their caps' triangles");
+  if (po.workers < 1) throw InputError(ErrorCode::kBadArgument, "pieces", -1, "workers must be at least 1");
+  PieceStats st;
+  // 1. Cut until every piece is small enough.
+  SolidPieces solid = cut_into_pieces(surface, options, po, &st);
+  const std::size_t count = solid.pieces.size();
+
+  // 2. Output numbering.
+  const std::vector<Index> out_id = merged_point_ids(solid);
+  Index used = 0;
+  for (Index id : out_id) used = std::max(used, id + 1);
+
+  // 3. Mesh the pieces, `workers` at a time, spooling their Steiner points and tets in piece
+  // order as they become ready.
   Scratch scratch;
   const std::string steiner_path = stem + ".steiner.spool", tets_path = stem + ".tets.spool";
   scratch.paths = {steiner_path, tets_path, stem + ".node.part", stem + ".ele.part"};
   File steiner_spool = open_file(steiner_path, "wb"), tets_spool = open_file(tets_path, "wb");
-  t0 = Clock::now();
-  std::int64_t steiner = 0;
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    check_cancel();
+  auto t0 = Clock::now();
+  struct Done {
+    bool ready = false;
     std::vector<Index> globals;
-    const SurfaceMesh local = local_surface(points, pieces[p], globals);
-    pieces[p] = {};
-    const std::string name = "piece " + std::to_string(p + 1) + "/" + std::to_string(pieces.size());
-    MeshOptions o = options;
-    if (options.progress) o.progress = [&](const std::string& stage, double f) { options.progress(name + ": " + stage, f); };
-    MeshStats ms;
-    const TetMesh m = tetrahedralize(local, o, &ms);
-    const Index nloc = static_cast<Index>(globals.size());
-    if (m.num_points() < nloc || !std::equal(local.xyz.begin(), local.xyz.end(), m.xyz.begin()))
-      throw MeshingError(ErrorCode::kInternal, "pieces", static_cast<std::int64_t>(p),
-                         name + ": the core did not put the piece's input points first");
-    if (po.check_pieces) {
-      MeshCheckOptions co;
-      co.compute_quality = false;
-      co.max_messages = 3;
-      const MeshCheckReport r = check_mesh(local, m, co);
-      if (!r.valid) {
-        std::string msg = name + ": its mesh failed the exact check";
-        for (const auto& s : r.messages) msg += "; " + s;
-        throw MeshingError(ErrorCode::kInternal, "pieces", static_cast<std::int64_t>(p), msg);
-      }
+    TetMesh mesh;
+    double seconds = 0;
+    std::exception_ptr error;
+  };
+  std::vector<Done> done(count);
+  std::mutex mutex;  // guards `done`, `next`, `stop` and the calls of the caller's callbacks
+  std::condition_variable ready;
+  std::size_t next = 0;
+  bool stop = false;
+  const bool serial = po.workers == 1 || count == 1;
+  auto name_of = [&](std::size_t p) { return "piece " + std::to_string(p + 1) + "/" + std::to_string(count); };
+  // Meshes the next piece; false when there is none left or the run stops.
+  auto mesh_next = [&]() -> bool {
+    std::size_t p;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (stop || next == count) return false;
+      p = next++;
     }
+    {
+      Done d;
+      try {
+        const auto tp = Clock::now();
+        const SurfaceMesh local = piece_surface(solid.xyz, solid.pieces[p], d.globals);
+        MeshOptions o = options;
+        o.cancelled = [&] {
+          std::lock_guard<std::mutex> lock(mutex);
+          return stop || (options.cancelled && options.cancelled());
+        };
+        if (options.progress && serial)
+          o.progress = [&](const std::string& stage, double f) { options.progress(name_of(p) + ": " + stage, f); };
+        else
+          o.progress = nullptr;
+        d.mesh = mesh_piece(local, o, po.check_pieces, name_of(p));
+        d.seconds = since(tp);
+      } catch (...) {
+        d.error = std::current_exception();
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      if (d.error) stop = true;
+      d.ready = true;
+      done[p] = std::move(d);
+      ready.notify_all();
+    }
+    return true;
+  };
+  std::vector<std::thread> threads;
+  struct Joiner {
+    std::vector<std::thread>& threads;
+    std::mutex& mutex;
+    bool& stop;
+    ~Joiner() {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        stop = true;
+      }
+      for (auto& t : threads) t.join();
+    }
+  } joiner{threads, mutex, stop};
+  if (!serial)
+    for (int w = 0; w < std::min<int>(po.workers, static_cast<int>(count)); ++w)
+      threads.emplace_back([&] {
+        while (mesh_next()) {
+        }
+      });
+  std::int64_t steiner = 0;
+  for (std::size_t p = 0; p < count; ++p) {
+    if (serial) {
+      if (options.cancelled && options.cancelled()) throw MeshingError(ErrorCode::kCancelled, "pieces", -1, "cancelled");
+      mesh_next();  // piece p
+    }
+    Done d;
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      if (!serial && options.progress) {
+        lock.unlock();
+        options.progress("meshing " + std::to_string(count) + " pieces on " + std::to_string(threads.size()) + " threads",
+                         static_cast<double>(p) / static_cast<double>(count));
+        lock.lock();
+      }
+      ready.wait(lock, [&] { return done[p].ready; });
+      d = std::move(done[p]);
+      done[p] = Done{};
+    }
+    if (d.error) std::rethrow_exception(d.error);
+    const TetMesh& m = d.mesh;
+    const Index nloc = static_cast<Index>(d.globals.size());
     std::fwrite(m.xyz.data() + 3 * static_cast<std::size_t>(nloc), sizeof(double),
                 m.xyz.size() - 3 * static_cast<std::size_t>(nloc), steiner_spool.get());
     std::vector<Index> tets(m.tet.size());
     for (std::size_t i = 0; i < m.tet.size(); ++i) {
       const Index v = m.tet[i];
-      tets[i] = v < nloc ? out_id[globals[v]] : static_cast<Index>(used + steiner + (v - nloc));
+      tets[i] = v < nloc ? out_id[d.globals[v]] : static_cast<Index>(used + steiner + (v - nloc));
     }
     std::fwrite(tets.data(), sizeof(Index), tets.size(), tets_spool.get());
     steiner += m.num_points() - nloc;
     st.tets += m.num_tets();
     if (po.log)
-      po.log(name + ": " + std::to_string(local.num_triangles()) + " triangles -> " + std::to_string(m.num_tets()) +
-             " tets, " + std::to_string(m.num_points() - nloc) + " Steiner points, " + std::to_string(ms.seconds_total) +
-             " s" + (po.check_pieces ? ", checked: valid" : ""));
+      po.log(name_of(p) + ": " + std::to_string(solid.pieces[p].size() / 3) + " triangles -> " +
+             std::to_string(m.num_tets()) + " tets, " + std::to_string(m.num_points() - nloc) + " Steiner points, " +
+             std::to_string(d.seconds) + " s" + (po.check_pieces ? ", checked: valid" : ""));
+    solid.pieces[p] = {};
   }
   finish(steiner_spool, steiner_path);
   finish(tets_spool, tets_path);
@@ -353,7 +494,7 @@ void tetrahedralize_in_pieces(const SurfaceMesh& surface, const MeshOptions& opt
     long long line = 0;
     for (std::size_t g = 0; g < out_id.size(); ++g)
       if (out_id[g] >= 0)
-        std::fprintf(node.get(), "%lld %.17g %.17g %.17g\n", ++line, points[3 * g], points[3 * g + 1], points[3 * g + 2]);
+        std::fprintf(node.get(), "%lld %.17g %.17g %.17g\n", ++line, solid.xyz[3 * g], solid.xyz[3 * g + 1], solid.xyz[3 * g + 2]);
     File in = File(std::fopen(steiner_path.c_str(), "rb"));
     std::vector<double> buf(3 * 4096);
     for (std::size_t got; in && (got = std::fread(buf.data(), sizeof(double), buf.size(), in.get())) > 0;)

@@ -212,6 +212,70 @@ TEST(OutOfCore, SameInputSameFilesAndNoScratchLeft) {
   }
 }
 
+// Pieces meshed on threads at once give the files of one thread, byte for byte (the contract's
+// determinism), for every number of workers.
+TEST(OutOfCore, WorkersMeshThePiecesAtOnceIntoTheSameFiles) {
+  const SurfaceMesh s = read_off(data("corpus/fertility.off"));
+  PieceOptions po;
+  po.max_piece_triangles = s.num_triangles() / 5;
+  po.min_piece_triangles = 100;
+  const std::string one = scratch("workers_1");
+  PieceStats ps1;
+  tetrahedralize_in_pieces(s, MeshOptions{}, po, one, &ps1);
+  ASSERT_GE(ps1.pieces, 5);
+  for (int workers : {2, 3, 16}) {
+    SCOPED_TRACE(workers);
+    po.workers = workers;
+    const std::string many = scratch("workers_n");
+    PieceStats ps;
+    tetrahedralize_in_pieces(s, MeshOptions{}, po, many, &ps);
+    EXPECT_EQ(ps.pieces, ps1.pieces);
+    EXPECT_TRUE(ps.pieces_checked);
+    EXPECT_EQ(slurp(one + ".node"), slurp(many + ".node"));
+    EXPECT_EQ(slurp(one + ".ele"), slurp(many + ".ele"));
+    std::remove((many + ".node").c_str());
+    std::remove((many + ".ele").c_str());
+  }
+  const MeshCheckReport r = check_mesh(s, read_tetgen(one));
+  EXPECT_TRUE(r.valid) << (r.messages.empty() ? "" : r.messages[0]);
+  std::remove((one + ".node").c_str());
+  std::remove((one + ".ele").c_str());
+}
+
+// The public steps (cut_into_pieces, piece_surface, mesh_piece, merged_point_ids), as an engine
+// that meshes the pieces elsewhere runs them, give tetrahedralize_in_pieces's mesh.
+TEST(OutOfCore, TheStepsRunByHandGiveTheSameMesh) {
+  const SurfaceMesh s = read_off(data("corpus/spot.off"));
+  PieceOptions po;
+  po.max_piece_triangles = 1500;
+  po.min_piece_triangles = 100;
+  const std::string stem = scratch("steps");
+  tetrahedralize_in_pieces(s, MeshOptions{}, po, stem);
+  const TetMesh whole = read_tetgen(stem);
+  const SolidPieces solid = cut_into_pieces(s, MeshOptions{}, po);
+  ASSERT_GE(solid.pieces.size(), 2u);
+  EXPECT_EQ(solid.input_points, s.num_points());
+  const std::vector<Index> ids = merged_point_ids(solid);
+  Index used = 0;
+  for (Index id : ids) used = std::max(used, id + 1);
+  TetMesh merged;
+  merged.xyz.resize(3 * static_cast<std::size_t>(used));
+  for (std::size_t g = 0; g < ids.size(); ++g)
+    if (ids[g] >= 0) std::copy(&solid.xyz[3 * g], &solid.xyz[3 * g + 3], &merged.xyz[3 * static_cast<std::size_t>(ids[g])]);
+  for (std::size_t p = 0; p < solid.pieces.size(); ++p) {
+    std::vector<Index> globals;
+    const SurfaceMesh local = piece_surface(solid.xyz, solid.pieces[p], globals);
+    const TetMesh m = mesh_piece(local, MeshOptions{}, true, "piece");
+    const Index nloc = local.num_points(), first_steiner = merged.num_points();
+    merged.xyz.insert(merged.xyz.end(), m.xyz.begin() + 3 * nloc, m.xyz.end());
+    for (Index v : m.tet) merged.tet.push_back(v < nloc ? ids[globals[v]] : first_steiner + v - nloc);
+  }
+  EXPECT_EQ(merged.xyz, whole.xyz);
+  EXPECT_EQ(merged.tet, whole.tet);
+  std::remove((stem + ".node").c_str());
+  std::remove((stem + ".ele").c_str());
+}
+
 // A run that stops (cancelled after its first piece, or refused) leaves the previous files as
 // they were and no scratch file.
 TEST(OutOfCore, AStoppedRunLeavesThePreviousMeshAlone) {
