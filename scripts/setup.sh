@@ -20,6 +20,8 @@ PACKAGES=(
   libtbb-dev  # named by OpenCASCADE's CMake targets
   # peak memory of each mesher's process in the comparison (GNU time)
   time
+  # pieces meshed on a cluster (FemBspTet/fem/cluster.py): Dask distributed
+  python3-distributed
 )
 
 missing=()

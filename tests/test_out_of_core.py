@@ -16,11 +16,11 @@ from FemBspTet.kernel.errors import InputError, MemoryBudgetError
 from FemBspTet.kernel.memory_budget import BASE_BYTES
 from FemBspTet.io.surface_io import read_surface
 from FemBspTet.io.volume_io import read_tet_mesh
-from FemBspTet.fem.pieces import OUT_OF_CORE_HOLD_PER_TRIANGLE, tetrahedralize_out_of_core
+from FemBspTet.fem.pieces import OUT_OF_CORE_HOLD_PER_TRIANGLE, tetrahedralize_in_pieces
 
 
 def budget_for_pieces(surface, piece_triangles):
-    """The budget under which tetrahedralize_out_of_core cuts ``surface`` into pieces of about
+    """The budget under which tetrahedralize_in_pieces cuts ``surface`` into pieces of about
     ``piece_triangles`` triangles (out_of_core.h's estimate: 32 MiB + 2 KiB per triangle)."""
     return (BASE_BYTES + OUT_OF_CORE_HOLD_PER_TRIANGLE * len(surface.triangles)
             + (32 << 20) + 2048 * piece_triangles)
@@ -36,9 +36,9 @@ def assert_valid_mesh_of(surface, mesh):
 @pytest.mark.parametrize("name", ["fertility", "knot2", "fandisk"])
 def test_pieces_make_one_valid_mesh(name):
     surface = read_surface(corpus_path(name))
-    mesh, stats = tetrahedralize_out_of_core(surface, budget_for_pieces(surface, 2500))
+    mesh, stats = tetrahedralize_in_pieces(surface, max_memory=budget_for_pieces(surface, 2500), workers=1)
     assert_valid_mesh_of(surface, mesh)
-    pieces = stats["out_of_core"]
+    pieces = stats["pieces"]
     assert pieces["pieces"] >= 3
     assert pieces["largest_piece_triangles"] <= max(2500, 1000) or pieces["uncut"]
     assert stats["tets"] == len(mesh.tets) and stats["points"] == len(mesh.points)
@@ -50,12 +50,12 @@ def test_pieces_make_one_valid_mesh(name):
 
 def test_out_of_core_refuses_what_it_cannot_do():
     surface = read_surface(corpus_path("spot"))
-    with pytest.raises(InputError, match="--out-of-core|out-of-core mode makes the core's mesh only"):
-        tetrahedralize_out_of_core(surface, 1 << 30, options={"size": 0.1})
+    with pytest.raises(InputError, match="pieces makes the core's mesh only"):
+        tetrahedralize_in_pieces(surface, {"size": 0.1}, max_memory=1 << 30)
     with pytest.raises(InputError, match="allow_boundary_steiner"):
-        tetrahedralize_out_of_core(surface, 1 << 30, options={"allow_boundary_steiner": True})
+        tetrahedralize_in_pieces(surface, {"allow_boundary_steiner": True}, max_memory=1 << 30)
     with pytest.raises(MemoryBudgetError, match="too small even for the out-of-core mode"):
-        tetrahedralize_out_of_core(surface, 64 << 20)
+        tetrahedralize_in_pieces(surface, max_memory=64 << 20, workers=1)
 
 
 def run(cli, *args):
@@ -70,9 +70,9 @@ def test_cli_out_of_core_writes_a_valid_mesh(cli, tmp_path, fmt):
     r = run(cli, "mesh", corpus_path("fertility"), "-o", out, "--max-memory", budget, "--out-of-core",
             "--stats-json", tmp_path / "stats.json")
     assert r.returncode == 0, r.stdout + r.stderr
-    assert "meshed out of core" in r.stderr
+    assert "meshed in" in r.stderr and "pieces" in r.stderr
     stats = json.loads((tmp_path / "stats.json").read_text())
-    assert stats["out_of_core"]["pieces"] >= 3
+    assert stats["pieces"]["pieces"] >= 3
     assert_valid_mesh_of(surface, read_tet_mesh(str(out)))
     assert not [p for p in os.listdir(tmp_path) if "spool" in p or p.endswith(".part")]
 

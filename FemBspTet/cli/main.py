@@ -4,7 +4,8 @@
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]
                    [--min-dihedral D] [--thickness-ratio K] [--surface-points exact|rounded] [--order 1|2]
                    [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
-                   [--max-memory SIZE] [--out-of-core] [--timeout SECONDS]
+                   [--max-memory SIZE] [--out-of-core] [--workers N] [--scheduler ADDRESS]
+                   [--timeout SECONDS]
     fembsptet check SURFACE TETMESH [--json]
     fembsptet compare INPUT [--size H] [--json FILE] [--plot FILE.png] [--timeout S] [--keep DIR]
     fembsptet benchmark MODELS_OR_FOLDERS... [--report FILE.md] [--divisions N] [--timeout S]
@@ -51,7 +52,7 @@ from ..kernel.progress import Progress
 from ..peers.process import DEFAULT_TIMEOUT
 from .addon_install import install
 from .supervisor import Limits, run_interruptible, run_supervised
-from ..fem.pieces import tetrahedralize_out_of_core
+from ..fem.pieces import default_workers, tetrahedralize_in_pieces
 
 
 # Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
@@ -202,7 +203,9 @@ def _mesh_cad_fem(args, progress):
                                             ("--allow-boundary-steiner",
                                              args.allow_boundary_steiner or None),
                                             ("--out-of-core", getattr(args, "out_of_core", None)
-                                             or None))
+                                             or None),
+                                            ("--workers", args.workers),
+                                            ("--scheduler", args.scheduler))
                    if value is not None]
     if unsupported:
         raise InputError("a CAD file is meshed by the FEM path, which does not take "
@@ -242,22 +245,26 @@ def _cmd_mesh(args):
     progress("reading input")
     surfaces = load_input(args.input, size=args.size)
 
-    if getattr(args, "out_of_core", False):
+    options = {k: v for k, v in (("size", args.size), ("min_size", args.min_size),
+                                 ("radius_edge", args.radius_edge),
+                                 ("min_dihedral", args.min_dihedral),
+                                 ("thickness_ratio", args.thickness_ratio),
+                                 ("surface_points", args.surface_points),
+                                 ("order", args.order),
+                                 ("allow_boundary_steiner", args.allow_boundary_steiner),
+                                 ("steiner_effort", args.steiner_effort),
+                                 ("bsp_seed", args.bsp_seed), ("reorient", args.reorient))
+               if v not in (None, False) and not (k == "order" and v == 1)}
+    workers = args.workers
+    core_only = not set(options) - {"steiner_effort", "bsp_seed", "reorient"}
+    if workers is None and args.scheduler is None:
+        workers = default_workers(sum(len(s.triangles) for s in surfaces)) if core_only else 1
+    if getattr(args, "out_of_core", False) or args.scheduler is not None or workers != 1:
         progress("tetrahedralizing in pieces")
         try:
-            mesh, stats = tetrahedralize_out_of_core(
-                surfaces, args.max_memory_bytes,
-                options={k: v for k, v in (("size", args.size), ("min_size", args.min_size),
-                                           ("radius_edge", args.radius_edge),
-                                           ("min_dihedral", args.min_dihedral),
-                                           ("thickness_ratio", args.thickness_ratio),
-                                           ("surface_points", args.surface_points),
-                                           ("order", args.order),
-                                           ("allow_boundary_steiner", args.allow_boundary_steiner),
-                                           ("steiner_effort", args.steiner_effort),
-                                           ("bsp_seed", args.bsp_seed), ("reorient", args.reorient))
-                         if v not in (None, False) and not (k == "order" and v == 1)},
-                progress=progress)
+            mesh, stats = tetrahedralize_in_pieces(
+                surfaces, options, max_memory=args.max_memory_bytes, workers=workers,
+                scheduler=args.scheduler, progress=progress)
         finally:
             progress.finish()
         return _finish_mesh(args, progress, t0, mesh, stats, surfaces)
@@ -649,6 +656,14 @@ def build_parser():
                         "written to disk before the next (the solid is cut along caps inside it; "
                         "their points become interior nodes); the core's mesh only: no --size, "
                         "quality or --order 2")
+    m.add_argument("--workers", metavar="N", type=int, default=None,
+                   help="mesh the solid in about N pieces, N at a time (default: every core for a "
+                        "surface of at least 200,000 triangles meshed by the core alone, else 1); "
+                        "the mesh depends on N, not on where the pieces ran")
+    m.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="mesh the pieces on the workers of this Dask cluster (tcp://HOST:8786; "
+                        "python3-distributed; every worker must import FemBspTet); --workers then "
+                        "defaults to the cluster's worker count")
     m.add_argument("--timeout", metavar="SECONDS", type=float, default=None,
                    help="stop the run after this many seconds (exit 124; no output is written)")
     m.set_defaults(func=_cmd_mesh)

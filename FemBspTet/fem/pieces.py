@@ -1,9 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The out-of-core mode: a solid too big for the memory budget cut into pieces, each meshed by the
-core alone and written to disk, the pieces read back as one mesh
-(``cpp_module/include/bsptet/pieces/out_of_core.h``).
+"""A solid meshed in pieces: for memory (the out-of-core mode, pieces small enough for a budget)
+and for speed (pieces meshed at the same time, on the threads of this process or on the workers
+of a Dask cluster). ``cpp_module/include/bsptet/pieces/out_of_core.h`` says how the solid is cut
+and why the pieces' meshes are one conforming mesh.
 
-    mesh, stats = tetrahedralize_out_of_core(surfaces, max_memory=4 << 30)
+    mesh, stats = tetrahedralize_in_pieces(surfaces, max_memory=4 << 30)       # out of core
+    mesh, stats = tetrahedralize_in_pieces(surfaces, workers=2)                # 2 threads
+    mesh, stats = tetrahedralize_in_pieces(surfaces, workers=4,
+                                           scheduler="tcp://head:8786")      # a Dask cluster
 """
 
 import os
@@ -19,28 +23,27 @@ from ..kernel.memory_budget import BASE_BYTES, format_bytes
 from ..kernel.mesh_types import Surface, TetMesh
 
 
-#: What the out-of-core mode holds besides the core's run on one piece (bytes per input triangle):
+#: What a run in pieces holds besides the core's runs on its pieces (bytes per input triangle):
 #: the input surface, its pieces' triangle lists, and the finished mesh read back for writing.
 OUT_OF_CORE_HOLD_PER_TRIANGLE = 256
 
+#: Below this many triangles a solid is meshed whole even when several workers are at hand: the
+#: cut and its checks cost about what the second worker saves (bench/parallel_pieces.py).
+PARALLEL_MIN_TRIANGLES = 200_000
 
-def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None, cancel=None):
-    """Meshes like :func:`tetrahedralize`, in pieces small enough for ``max_memory`` bytes: the
-    out-of-core mode (``cpp_module/include/bsptet/pieces/out_of_core.h``; the paper's Sec. 4.3 swaps
-    finished cells to disk, this core's peak being in its seed instead the solid is cut).
 
-    Each solid is cut into pieces along caps inside it made of its own vertices and points of
-    their own (so the pieces meet exactly and the caps' points are interior Steiner points of the
-    mesh), each piece is meshed by the core alone, checked exactly against its own surface (which
-    checks the whole mesh, piece by piece) and written to disk, then the pieces are streamed into
-    one file and read back. The piece size comes from the budget (``piece_triangles_for_budget``,
-    after what the run holds besides: ``OUT_OF_CORE_HOLD_PER_TRIANGLE`` bytes per triangle).
+def default_workers(triangles):
+    """The workers a run on ``triangles`` triangles uses when the caller names none: every core
+    this process may run on for inputs of at least :data:`PARALLEL_MIN_TRIANGLES`, else 1."""
+    if triangles < PARALLEL_MIN_TRIANGLES:
+        return 1
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
 
-    ``options``: ``steiner_effort``, ``bsp_seed``, ``reorient`` as for :func:`tetrahedralize`;
-    the quality options, ``order`` 2 and ``allow_boundary_steiner`` are refused (the core's mesh
-    only). Returns ``(TetMesh, stats)``; ``stats["out_of_core"]`` holds the pieces' figures.
-    """
-    options = dict(options or {})
+
+def _refuse_options(options):
     unknown = set(options) - set(OPTION_NAMES)
     if unknown:
         raise InputError(f"unknown mesher option(s): {', '.join(sorted(unknown))}")
@@ -48,13 +51,70 @@ def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None
                      if v not in (None, False) and (k in REFINE_OPTIONS and not (k == "order" and int(v) == 1)
                                                     or k == "allow_boundary_steiner"))
     if refused:
-        raise InputError("the out-of-core mode makes the core's mesh only: drop "
-                         + ", ".join(refused) + " (or mesh in memory, without --out-of-core)")
-    if max_memory is None:
-        raise InputError("the out-of-core mode needs a memory budget (--max-memory SIZE): the "
-                         "memory available could not be read")
+        raise InputError("meshing in pieces makes the core's mesh only: drop "
+                         + ", ".join(refused) + " (or mesh whole, without --out-of-core and with "
+                         "--workers 1)")
+
+
+def _piece_size(lib, triangles, total, max_memory, workers, max_piece_triangles, where):
+    """The largest piece, in triangles, for a solid of ``triangles`` triangles in a run on
+    ``total`` (see :func:`tetrahedralize_in_pieces`)."""
+    if max_piece_triangles is not None:
+        return int(max_piece_triangles)
+    sizes = []
+    if max_memory is not None:
+        usable = (int(max_memory) - BASE_BYTES - OUT_OF_CORE_HOLD_PER_TRIANGLE * total) // workers
+        piece = lib.piece_triangles_for_budget(usable) if usable > 0 else 0
+        if usable <= 0 or lib.piece_triangles_for_budget(1) > piece:
+            held = OUT_OF_CORE_HOLD_PER_TRIANGLE * total + BASE_BYTES
+            raise MemoryBudgetError(
+                f"a memory budget of {format_bytes(max_memory)} is too small even for the out-of-core "
+                f"mode on {total} triangles with {workers} worker(s) (it holds about "
+                f"{format_bytes(held)} besides the pieces); raise --max-memory or lower --workers",
+                where=where, estimate=held, budget=int(max_memory))
+        sizes.append(piece)
+    if workers > 1:
+        sizes.append(lib.piece_triangles_for_workers(triangles, workers))
+    if not sizes:
+        raise InputError("meshing in pieces needs a memory budget (--max-memory SIZE), more than one "
+                         "worker or a piece size")
+    return min(sizes)
+
+
+def tetrahedralize_in_pieces(surfaces, options=None, *, max_memory=None, workers=None, scheduler=None,
+                             max_piece_triangles=None, progress=None, cancel=None):
+    """Meshes like :func:`FemBspTet.kernel.core.tetrahedralize` without quality options, each
+    solid cut into pieces that are meshed by the core alone, each checked exactly against its own
+    surface (which checks the whole mesh, piece by piece), and merged in piece order.
+
+    The piece size: ``max_piece_triangles`` when given, else the smallest of what ``max_memory``
+    bytes allow ``workers`` pieces at once (after what the run holds besides:
+    ``OUT_OF_CORE_HOLD_PER_TRIANGLE`` bytes per triangle) and what lets ``workers`` pieces run at
+    once (``piece_triangles_for_workers``). The mesh depends on the piece size only, never on
+    ``workers`` or on where the pieces ran.
+
+    ``scheduler``: None to mesh ``workers`` pieces at a time on threads of this process; a Dask
+    scheduler's address (``tcp://host:8786``) or a ``distributed.Client`` to mesh them on that
+    cluster's workers (:mod:`FemBspTet.fem.cluster`). ``workers`` None: the cluster's worker
+    count, or without a cluster :func:`default_workers`.
+
+    ``options``: ``steiner_effort``, ``bsp_seed``, ``reorient`` as for ``tetrahedralize``; the
+    quality options, ``order`` 2 and ``allow_boundary_steiner`` are refused. Returns ``(TetMesh,
+    stats)``; ``stats["pieces"]`` holds the pieces' figures (a list with several solids).
+    """
+    options = dict(options or {})
+    _refuse_options(options)
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
+    if workers is None and scheduler is not None:
+        from .cluster import cluster_workers
+
+        workers = cluster_workers(scheduler)
+    elif workers is None:
+        workers = default_workers(sum(len(s.triangles) for s in surfaces))
+    workers = int(workers)
+    if workers < 1:
+        raise InputError(f"workers must be at least 1, got {workers}")
     lib = native()
     reorient = bool(options.get("reorient", False))
     checked, flipped = [], 0
@@ -63,15 +123,7 @@ def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None
         checked.append(checked_surface)
         flipped += info["flipped_triangles"]
     total = sum(len(s.triangles) for s in checked)
-    usable = int(max_memory) - BASE_BYTES - OUT_OF_CORE_HOLD_PER_TRIANGLE * total
-    piece = lib.piece_triangles_for_budget(usable) if usable > 0 else 0
-    if usable <= 0 or lib.piece_triangles_for_budget(1) > piece:
-        raise MemoryBudgetError(
-            f"a memory budget of {format_bytes(max_memory)} is too small even for the out-of-core "
-            f"mode on {total} triangles (it holds about {format_bytes(OUT_OF_CORE_HOLD_PER_TRIANGLE * total + BASE_BYTES)} "
-            "besides the pieces); raise --max-memory", where=checked[0].source or None,
-            estimate=OUT_OF_CORE_HOLD_PER_TRIANGLE * total + BASE_BYTES, budget=int(max_memory))
-    meshes, all_stats = [], []
+    meshes, all_stats, sizes = [], [], []
     with tempfile.TemporaryDirectory(prefix="fembsptet_pieces_") as scratch:
         for k, surface in enumerate(checked):
             label = f"solid {k + 1} of {len(checked)}: " if len(checked) > 1 else ""
@@ -80,37 +132,48 @@ def tetrahedralize_out_of_core(surfaces, max_memory, options=None, progress=None
                 if progress is not None:
                     progress(label + stage, fraction)
 
-            stem = os.path.join(scratch, f"solid{k}")
-            with core_errors(surface, "out-of-core mesher"):
-                pieces = lib.tetrahedralize_in_pieces(
-                    surface.points, surface.triangles, stem, piece, progress=report, cancel=cancel,
-                    **native_core_options(options))
-            mesh = read_tetgen(stem)
-            os.remove(stem + ".node")
-            os.remove(stem + ".ele")
-            mesh = TetMesh(mesh.points, mesh.tets, surface.source)
+            piece = _piece_size(lib, len(surface.triangles), total, max_memory, workers,
+                                max_piece_triangles, surface.source or None)
+            sizes.append(piece)
+            if scheduler is not None:
+                from .cluster import mesh_pieces_on_cluster
+
+                mesh, pieces = mesh_pieces_on_cluster(surface, piece, scheduler, options,
+                                                      progress=report, cancel=cancel)
+            else:
+                stem = os.path.join(scratch, f"solid{k}")
+                with core_errors(surface, "pieces mesher"):
+                    pieces = lib.tetrahedralize_in_pieces(
+                        surface.points, surface.triangles, stem, piece, progress=report,
+                        cancel=cancel, workers=workers, **native_core_options(options))
+                mesh = read_tetgen(stem)
+                os.remove(stem + ".node")
+                os.remove(stem + ".ele")
+                mesh = TetMesh(mesh.points, mesh.tets, surface.source)
+            pieces["workers"] = workers
             n_input = len(np.unique(surface.triangles))
             st = {"input_points": int(len(surface.points)), "input_triangles": int(len(surface.triangles)),
                   "points": int(pieces["points"]), "tets": int(pieces["tets"]),
                   "steiner_points": int(pieces["points"]) - n_input, "boundary_steiner_points": 0,
                   "interior_steiner_points": int(pieces["points"]) - n_input,
-                  "quality": tet_quality(mesh), "out_of_core": dict(pieces)}
+                  "quality": tet_quality(mesh), "pieces": dict(pieces)}
             meshes.append(mesh)
             all_stats.append(st)
-    out_of_core = [st.pop("out_of_core") for st in all_stats]
+    per_solid = [st.pop("pieces") for st in all_stats]
     mesh = concatenate_meshes(meshes)
     stats = merge_stats(all_stats)
-    stats["out_of_core"] = out_of_core[0] if len(out_of_core) == 1 else out_of_core
+    stats["pieces"] = per_solid[0] if len(per_solid) == 1 else per_solid
     stats["order"] = 1
     stats["nodes"] = int(len(mesh.points))
-    stats["valid"] = True  # every piece was checked exactly (tetrahedralize_in_pieces)
+    stats["valid"] = True  # every piece was checked exactly (out_of_core.h)
     stats["flipped_triangles"] = flipped
-    notes = [f"meshed out of core: {sum(p['pieces'] for p in out_of_core)} pieces of at most "
-             f"{piece} triangles; {sum(p['cap_points'] for p in out_of_core)} of the Steiner points "
+    where = "on a Dask cluster" if scheduler is not None else f"on {workers} thread(s)"
+    notes = [f"meshed in {sum(p['pieces'] for p in per_solid)} pieces of at most {max(sizes)} "
+             f"triangles, {where}; {sum(p['cap_points'] for p in per_solid)} of the Steiner points "
              "are the caps' own points, inside the solid"]
     if flipped:
         notes.append(f"re-oriented {flipped} triangle(s) (--reorient)")
-    for p in out_of_core:
+    for p in per_solid:
         notes.extend(p["uncut"])
     stats["notes"] = notes
     return mesh, stats

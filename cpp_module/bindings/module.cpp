@@ -373,6 +373,8 @@ PYBIND11_MODULE(_bsptet, m) {
       "Step 2 of tetrahedralize_in_pieces (out_of_core.h mesh_piece) on a piece's own surface: returns "
       "(points, tets), the piece's points first, then its Steiner points; checked exactly with check.");
 
+  m.def("piece_triangles_for_workers", &piece_triangles_for_workers, py::arg("triangles"), py::arg("workers"),
+        "The piece size (triangles) for `workers` pieces meshed at once (out_of_core.h).");
   m.def("piece_triangles_for_budget", &piece_triangles_for_budget, py::arg("budget_bytes"),
         "The largest piece (triangles) the out-of-core mode's estimate fits in budget_bytes (out_of_core.h).");
 
