@@ -13,7 +13,8 @@ from FemBspTet.fem.pieces import tetrahedralize_in_pieces
 from FemBspTet.io.surface_io import read_surface
 from FemBspTet.io.volume_io import read_tet_mesh, write_tet_mesh
 from FemBspTet.kernel import core
-from FemBspTet.kernel.errors import InputError
+from FemBspTet.kernel.errors import InputError, SelfIntersectionError
+from FemBspTet.kernel.mesh_types import Surface
 
 PIECE = 3000  # fertility has 9,000 triangles: 5 pieces
 
@@ -82,3 +83,13 @@ def test_pieces_refuse_quality_options_and_bad_counts():
         tetrahedralize_in_pieces(surface, {"min_dihedral": 15}, workers=2)
     with pytest.raises(InputError, match="at least 1"):
         tetrahedralize_in_pieces(surface, workers=0)
+
+
+def test_a_self_intersecting_surface_is_refused_while_the_pieces_run():
+    # The self-intersection search runs beside the cutting and meshing: its error is the run's.
+    one = read_surface(corpus_path("fertility"))
+    shift = 0.1 * np.ptp(one.points, axis=0)
+    twice = Surface(np.vstack([one.points, one.points + shift]),
+                    np.vstack([one.triangles, one.triangles + len(one.points)]))
+    with pytest.raises(SelfIntersectionError):
+        tetrahedralize_in_pieces(twice, workers=2, max_piece_triangles=PIECE)

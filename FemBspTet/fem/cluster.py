@@ -15,6 +15,8 @@ use a cluster as a library call. Every worker must be able to import ``FemBspTet
 on its ``PYTHONPATH``).
 """
 
+import time
+
 import numpy as np
 
 from ..kernel.core import core_errors, native, native_core_options
@@ -22,7 +24,7 @@ from ..kernel.errors import InputError, InternalError, MeshingCancelled
 from ..kernel.mesh_types import TetMesh
 
 #: How often (seconds) a wait for the next piece looks at ``cancel``.
-POLL_SECONDS = 0.25
+POLL_SECONDS = 0.05
 
 
 def mesh_piece_task(points, triangles, name, core_options):
@@ -78,8 +80,6 @@ def mesh_pieces_on_cluster(surface, max_piece_triangles, scheduler, options, pro
     """The solid bounded by ``surface`` (checked) in pieces of at most ``max_piece_triangles``
     triangles, meshed on the cluster of ``scheduler``. Returns ``(TetMesh, stats)``, stats as
     ``_bsptet.tetrahedralize_in_pieces`` gives them."""
-    from distributed import wait
-
     lib = native()
     core_options = native_core_options(options)
     client, own = client_for(scheduler)
@@ -99,7 +99,8 @@ def mesh_pieces_on_cluster(surface, max_piece_triangles, scheduler, options, pro
         used = int(ids.max()) + 1
         points, tets, steiner = [xyz[ids >= 0]], [], 0  # ids grow with the index: in id order
         for k, future in enumerate(futures):
-            while not wait([future], timeout=POLL_SECONDS).done:
+            while not future.done():
+                time.sleep(POLL_SECONDS)
                 if cancel is not None and cancel():
                     client.cancel(futures)
                     raise MeshingCancelled("cancelled")

@@ -10,6 +10,7 @@ and why the pieces' meshes are one conforming mesh.
                                            scheduler="tcp://head:8786")      # a Dask cluster
 """
 
+import concurrent.futures
 import os
 import tempfile
 
@@ -118,10 +119,33 @@ def tetrahedralize_in_pieces(surfaces, options=None, *, max_memory=None, workers
     lib = native()
     reorient = bool(options.get("reorient", False))
     checked, flipped = [], 0
-    for surface in surfaces:
-        checked_surface, info = check_surface(surface, reorient=reorient)
+    for surface in surfaces:  # all of the check but the self-intersection search (below)
+        checked_surface, info = check_surface(surface, reorient=reorient, self_intersections=False)
         checked.append(checked_surface)
         flipped += info["flipped_triangles"]
+    # The self-intersection search runs beside the cutting and meshing, as the core's own run
+    # does it (mesher.h check_and_tetrahedralize): a surface it refuses stops the run and its
+    # error is raised, whatever the pieces' runs made of it meanwhile.
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        search = pool.submit(lambda: [check_surface(s) for s in checked])
+
+        def stop():
+            return (search.done() and search.exception() is not None) or (cancel is not None and cancel())
+
+        try:
+            mesh, stats, sizes = _mesh_checked(lib, checked, options, max_memory, workers, scheduler,
+                                               max_piece_triangles, progress, stop)
+        except Exception:
+            search.result()  # the surface's own error first
+            raise
+        search.result()
+    _pieces_summary(stats, sizes, scheduler, workers, flipped)
+    return mesh, stats
+
+
+def _mesh_checked(lib, checked, options, max_memory, workers, scheduler, max_piece_triangles,
+                  progress, cancel):
+    """tetrahedralize_in_pieces on checked surfaces: (mesh, stats, piece size of each solid)."""
     total = sum(len(s.triangles) for s in checked)
     meshes, all_stats, sizes = [], [], []
     with tempfile.TemporaryDirectory(prefix="fembsptet_pieces_") as scratch:
@@ -166,6 +190,12 @@ def tetrahedralize_in_pieces(surfaces, options=None, *, max_memory=None, workers
     stats["order"] = 1
     stats["nodes"] = int(len(mesh.points))
     stats["valid"] = True  # every piece was checked exactly (out_of_core.h)
+    return mesh, stats, sizes
+
+
+def _pieces_summary(stats, sizes, scheduler, workers, flipped):
+    """The run's notes and ``flipped_triangles`` in ``stats``."""
+    per_solid = stats["pieces"] if isinstance(stats["pieces"], list) else [stats["pieces"]]
     stats["flipped_triangles"] = flipped
     where = "on a Dask cluster" if scheduler is not None else f"on {workers} thread(s)"
     notes = [f"meshed in {sum(p['pieces'] for p in per_solid)} pieces of at most {max(sizes)} "
@@ -176,4 +206,3 @@ def tetrahedralize_in_pieces(surfaces, options=None, *, max_memory=None, workers
     for p in per_solid:
         notes.extend(p["uncut"])
     stats["notes"] = notes
-    return mesh, stats
