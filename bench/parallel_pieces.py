@@ -7,8 +7,8 @@ process and on the workers of a local Dask cluster, beside the core in one piece
     bench/parallel_pieces.py [--families sphere,torus,cad] [--sizes 1e5,1e6] [--inputs FILE.off ...]
                              [--workers 2] [--cluster-workers 2,4]
                              [--meshers ours,threads,dask,tetgen,gmsh] [--mesher-binary PATH]
-                             [--timeout S] [--keep DIR] [--check] [--markdown FILE] [--json FILE]
-                             [--note TEXT]
+                             [--timeout S] [--gmsh-max-tets N] [--keep DIR] [--check]
+                             [--markdown FILE] [--json FILE] [--note TEXT]
 
 The surfaces are the scaling benchmark's (bench/scaling.py: a cube-sphere, a torus, the OCCT
 bottle tessellated by FreeCAD; any size, e.g. ``--sizes 6.5e6 --families sphere`` for a mesh of
@@ -29,7 +29,9 @@ timed by ``FemBspTet.peers.process.run_measured`` (wall seconds, peak RSS from G
 * ``tetgen -pY``: ``tetgen -pYQ FILE.off``;
 * ``gmsh hxt 2 threads``: ``gmsh GEO -3 -algo hxt -nt 2`` on the same discrete surface, sized by
   the comparison's default rule (``CharacteristicLengthMax`` = the mean input edge length;
-  FemBspTet.peers.gmsh). HXT refines the interior: its tet counts are not the core's.
+  FemBspTet.peers.gmsh). HXT refines the interior: its tet counts are not the core's, and they
+  grow as the input's to the power 1.5 (about 3e6 at 10^5 sphere triangles, 10^9 at 6.5e6), so
+  it is not run where it would make more than --gmsh-max-tets (default 6e7, about 12 GB).
 
 A run over --timeout is recorded as ``timeout``. ``--check`` reads every mesh back and checks it
 exactly against the input surface (``FemBspTet.kernel.core.check_mesh``; valid and volume equal),
@@ -48,6 +50,8 @@ import sys
 import tempfile
 import time
 
+import numpy as np
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "bench"))
@@ -57,6 +61,9 @@ import scaling  # noqa: E402 (bench/: the surfaces, the tables)
 
 MESHERS = ("ours", "threads", "dask", "tetgen", "gmsh")
 GMSH_THREADS = 2
+#: Gmsh's HXT fills the solid at the mean input edge length h: about this many tets per h^3 of
+#: volume (measured: 4.1 on the 10^5 sphere, 4.4 on the torus), and about 200 bytes per tet.
+HXT_TETS_PER_VOLUME = 4.2
 _RESULT = "DASK_RESULT "
 
 
@@ -178,13 +185,18 @@ def run_tetgen(off, workdir, timeout):
     return row, stem
 
 
-def run_gmsh_hxt(surface, workdir, timeout, check):
-    """Gmsh's HXT on ``GMSH_THREADS`` threads, the .msh/.geo written as FemBspTet.peers.gmsh does."""
+def run_gmsh_hxt(surface, workdir, timeout, check, max_tets=None):
+    """Gmsh's HXT on ``GMSH_THREADS`` threads, the .msh/.geo written as FemBspTet.peers.gmsh does;
+    not run when it would make more than about ``max_tets`` tets (:data:`HXT_TETS_PER_VOLUME`)."""
     from FemBspTet.kernel import core
     from FemBspTet.kernel.errors import InternalError
     from FemBspTet.peers import gmsh
 
     size = gmsh.mean_edge_length(surface)
+    expected = HXT_TETS_PER_VOLUME * scaling.signed_volume(surface.points, surface.triangles) / size ** 3
+    if max_tets and expected > max_tets:
+        return {"gmsh_size": size, "status": "not run", "message": f"would make about {expected:.2g} "
+                f"tets at size {size:.3g} (over --gmsh-max-tets {max_tets:.2g})"}
     gmsh._write_surface_msh(os.path.join(workdir, "in.msh"), surface)
     geo, out = os.path.join(workdir, "surface.geo"), os.path.join(workdir, "out.msh")
     gmsh._write_geo(geo, "in.msh", size, remesh_surface=False)
@@ -200,8 +212,9 @@ def run_gmsh_hxt(surface, workdir, timeout, check):
         return row
     row.update(status="ok", message="", seconds=run.seconds, peak_mb=run.peak_rss_mb,
                tets=len(mesh.tets), nodes=len(mesh.points))
-    if check:
-        gmsh.restore_input_points(mesh, surface)
+    if check:  # Gmsh's own coincident nodes, then those the 16-digit round trip made
+        row["duplicate_points"] = int(len(mesh.points) - len(np.unique(mesh.points, axis=0)))
+        row["restored_points"] = gmsh.restore_input_points(mesh, surface)
         report = core.check_mesh(surface, mesh, max_messages=3, compute_quality=False)
         row["valid"] = bool(report["valid"] and report["volume_equal"])
         if not row["valid"]:
@@ -235,7 +248,7 @@ def run_one(args, kind, workers, surface, off, workdir):
     elif kind == "tetgen":
         row, stem = run_tetgen(off, workdir, args.timeout)
     else:
-        return run_gmsh_hxt(surface, workdir, args.timeout, args.check)
+        return run_gmsh_hxt(surface, workdir, args.timeout, args.check, args.gmsh_max_tets)
     if args.check and row["status"] == "ok":
         valid, _tets = out_of_core.check(surface, stem)
         row["valid"] = valid and row.get("valid", True)
@@ -258,8 +271,10 @@ def _ratio(a, b, fmt="{:.2f}"):
 def table(rows):
     heads = ["mesher", "seconds", "peak MB", "tets", "pieces", "speed-up", "efficiency",
              "time / tetgen -pY", "time / gmsh hxt", "valid", "notes"]
-    first = lambda kind: next((r for r in rows if r["kind"] == kind), None)  # noqa: E731
-    one, tg, gm = first("ours"), first("tetgen"), first("gmsh")
+    first = {}
+    for r in rows:
+        first.setdefault(r["kind"], r)
+    one, tg, gm = first.get("ours"), first.get("tetgen"), first.get("gmsh")
     body = []
     for r in rows:
         ok = r["status"] == "ok"
@@ -275,7 +290,7 @@ def table(rows):
             notes = (f"cluster start {r['startup_seconds']:.1f} s, process {r['process_seconds']:.1f} s; "
                      f"client {r['client_peak_mb']:.0f} MB")
         elif ok and r["kind"] == "gmsh":
-            notes = f"size {r['gmsh_size']:.3g}"
+            notes = f"size {r['gmsh_size']:.3g}" + (f"; {notes}" if notes else "")
         body.append([r["mesher"], f"{r['seconds']:.2f}" if ok else r["status"], peak,
                      str(r.get("tets", "-")), str(r.get("pieces", "-")), speed, eff,
                      _ratio(r, tg), _ratio(r, gm),
@@ -318,7 +333,8 @@ def report(command, args, inputs, rows, env, elapsed):
               "- tetgen -pY: `tetgen -pYQ`, one thread. gmsh hxt: `gmsh GEO -3 -algo hxt -nt "
               f"{GMSH_THREADS}` on the discrete surface, CharacteristicLengthMax = the mean input "
               "edge length (the comparison's default); HXT refines the interior, so its tets are "
-              "more and its times are not the same job.",
+              "more and its times are not the same job; it is not run where it would make more "
+              f"than {args.gmsh_max_tets:.2g} tets (--gmsh-max-tets).",
               "- speed-up: seconds of ours 1 / seconds of the row; efficiency: speed-up / the row's "
               "workers (threads or processes); time / tetgen -pY and time / gmsh hxt: the row's "
               "seconds over theirs (below 1: faster).",
@@ -375,6 +391,9 @@ def main(argv=None):
     ap.add_argument("--meshers", default=",".join(MESHERS), help="of " + ", ".join(MESHERS))
     ap.add_argument("--mesher-binary", default=os.path.join(ROOT, "build", "cpp_module", "bsptet_mesh"))
     ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per run (default 1800)")
+    ap.add_argument("--gmsh-max-tets", type=float, default=6e7,
+                    help="skip Gmsh where it would make more tets than this (about 200 bytes "
+                         "each; default 6e7; 0: no limit)")
     ap.add_argument("--keep", default=None, metavar="DIR", help="keep the inputs and meshes here")
     ap.add_argument("--check", action="store_true", help="check every mesh exactly (untimed)")
     ap.add_argument("--markdown", default=os.path.join(ROOT, "docs", "benchmarks", "parallel-pieces.md"))

@@ -6,8 +6,8 @@
 A module imports only its own room and the rooms below it; nothing imports gui (FreeCAD does,
 through InitGui.py) except the document object attaching its view provider when FreeCAD's GUI
 is up; no circle among module-level imports; and no import inside a function except of FreeCAD,
-an optional program or library that may be missing (matplotlib, rich, gmsh, netgen), or the
-FreeCAD layer from the package's facade (``FemBspTet.make_mesher`` and friends), or of the compiled
+an optional program or library that may be missing (matplotlib, rich, gmsh, netgen, Dask's
+distributed), or the FreeCAD layer from the package's facade (``FemBspTet.make_mesher`` and friends), or of the compiled
 core (its loader says how to build it when it is missing)."""
 
 import ast
@@ -24,7 +24,8 @@ GUI_ATTACH = {("FemBspTet.freecad.mesher_object", "FemBspTet.gui.view_provider")
 #: top-level modules that may be missing, so are imported where they are used
 OPTIONAL = ("FreeCAD", "FreeCADGui", "Part", "Fem", "FemGui", "ObjectsFem", "femmesh", "femtools",
             "femobjects", "femviewprovider", "femtaskpanels", "femguiutils", "PySide", "PySide2",
-            "pivy", "matplotlib", "mpl_toolkits", "rich", "gmsh", "netgen", "Mesh", "MeshPart")
+            "pivy", "matplotlib", "mpl_toolkits", "rich", "gmsh", "netgen", "distributed", "Mesh",
+            "MeshPart")
 
 
 def modules():

@@ -31,9 +31,7 @@ def mesh_piece_task(points, triangles, name, core_options):
     """Runs on a worker: one piece's surface meshed by the core and checked exactly. Returns the
     Steiner points (the piece's own points come first in the core's mesh and are left out) and
     the tets over the piece's points then those Steiner points."""
-    from .._bsptet import mesh_piece
-
-    mesh_points, tets = mesh_piece(points, triangles, name, check=True, **core_options)
+    mesh_points, tets = native().mesh_piece(points, triangles, name, check=True, **core_options)
     return mesh_points[len(points):], tets
 
 

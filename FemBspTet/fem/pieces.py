@@ -17,6 +17,7 @@ import tempfile
 import numpy as np
 
 from ..io.volume_io import read_tetgen
+from .cluster import cluster_workers, mesh_pieces_on_cluster
 from ..kernel.core import (OPTION_NAMES, REFINE_OPTIONS, check_surface, concatenate_meshes,
                            core_errors, merge_stats, native, native_core_options, tet_quality)
 from ..kernel.errors import InputError, MemoryBudgetError
@@ -108,8 +109,6 @@ def tetrahedralize_in_pieces(surfaces, options=None, *, max_memory=None, workers
     if isinstance(surfaces, Surface):
         surfaces = [surfaces]
     if workers is None and scheduler is not None:
-        from .cluster import cluster_workers
-
         workers = cluster_workers(scheduler)
     elif workers is None:
         workers = default_workers(sum(len(s.triangles) for s in surfaces))
@@ -160,8 +159,6 @@ def _mesh_checked(lib, checked, options, max_memory, workers, scheduler, max_pie
                                 max_piece_triangles, surface.source or None)
             sizes.append(piece)
             if scheduler is not None:
-                from .cluster import mesh_pieces_on_cluster
-
                 mesh, pieces = mesh_pieces_on_cluster(surface, piece, scheduler, options,
                                                       progress=report, cancel=cancel)
             else:
