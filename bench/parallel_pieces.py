@@ -125,27 +125,6 @@ def _vm_hwm_mb():
     return None
 
 
-def _polling_wait():
-    """``distributed.wait`` raises TimeoutError when its timeout passes (distributed 2022.12),
-    where the engine's poll for cancel (FemBspTet.fem.cluster) expects the futures back, not
-    done: this wrapper gives it that answer. Returns a list whose item counts the timeouts it
-    caught (in the JSON rows: 0 once the engine handles them itself)."""
-    import distributed
-    from distributed.client import DoneAndNotDoneFutures
-
-    original, caught = distributed.wait, [0]
-
-    def wait(fs, timeout=None, **kw):
-        try:
-            return original(fs, timeout=timeout, **kw)
-        except TimeoutError:
-            caught[0] += 1
-            return DoneAndNotDoneFutures(set(), set(fs))
-
-    distributed.wait = wait
-    return caught
-
-
 def dask_child(off, stem, workers, write):
     """The --dask-child process: starts the cluster, meshes, prints one JSON line."""
     from distributed import Client, LocalCluster
@@ -154,7 +133,6 @@ def dask_child(off, stem, workers, write):
     from FemBspTet.io.surface_io import read_surface
     from FemBspTet.io.volume_io import write_tet_mesh
 
-    caught = _polling_wait()
     t0 = time.perf_counter()
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster) as client:
@@ -171,7 +149,7 @@ def dask_child(off, stem, workers, write):
         "seconds": t2 - t1, "startup_seconds": t1 - t0, "tets": int(len(mesh.tets)),
         "nodes": int(len(mesh.points)), "pieces": int(stats["pieces"]["pieces"]),
         "valid": bool(stats["valid"]), "worker_peak_mb": sorted(peaks.values()),
-        "client_peak_mb": client_peak, "wait_timeouts_caught": caught[0]}), flush=True)
+        "client_peak_mb": client_peak}), flush=True)
     return 0
 
 
