@@ -383,7 +383,10 @@ def main(argv=None):
             ap.error(f"unknown mesher {m}")
     if not os.access(args.mesher_binary, os.X_OK):
         ap.error(f"no executable {args.mesher_binary}")
-    command = "bench/parallel_pieces.py " + shlex.join(argv)
+    # The report's command without the options that name files of this machine's run.
+    shown = [a for i, a in enumerate(argv) if a not in ("--json", "--keep")
+             and (i == 0 or argv[i - 1] not in ("--json", "--keep"))]
+    command = "bench/parallel_pieces.py " + shlex.join(shown)
     from FemBspTet.io.atomic_file import atomic_output
     from FemBspTet.io.surface_io import read_surface
 
