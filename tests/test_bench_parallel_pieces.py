@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """bench/parallel_pieces.py end to end on a small sphere: the core on one thread and on two, a
 local Dask cluster of two workers, tetgen -pY and Gmsh's HXT, every mesh read back and checked
-exactly (the figures themselves are the benchmark's)."""
+exactly: ours must be valid; a peer's verdict is reported (Gmsh's HXT on two threads has left
+coincident nodes now and then). The figures themselves are the benchmark's."""
 
 import json
 import os
@@ -30,7 +31,12 @@ def test_benchmark_script_runs_and_checks_every_mesh(tmp_path):
             assert shutil.which(row["kind"]) is None, row
             continue
         assert row["status"] == "ok", row
-        assert row["valid"] is True and row["tets"] > 0, row
+        assert row["tets"] > 0, row
+        if row["kind"] in ("gmsh", "tetgen"):  # a peer's mesh is checked and reported, not ours
+            assert isinstance(row["valid"], bool), row
+            assert row["valid"] or f"| {row['mesher']} |" in report.read_text()
+        else:
+            assert row["valid"] is True, row
     by = {row["mesher"]: row for row in rows}
     assert by["ours 2 threads"]["pieces"] >= 2
     assert len(by["ours Dask 2"]["worker_peak_mb"]) == 2
