@@ -5,8 +5,8 @@
 This process cuts the solid (``_bsptet.cut_into_pieces``), sends each piece's own surface to the
 cluster as one task (``_bsptet.mesh_piece`` on a worker: the core, then the exact check of the
 piece's mesh against its surface), and merges the pieces' meshes in piece order as they come
-back, numbered as ``tetrahedralize_in_pieces`` numbers them (out_of_core.h
-``merged_point_ids``): the mesh is the one the threads of one process make, byte for byte.
+back, numbered by the ids ``cut_into_pieces`` returns (out_of_core.h ``merged_point_ids``): the
+mesh is the one the threads of one process make, byte for byte.
 
 Why Dask rather than MPI: the same code runs on a local cluster of processes and on a cluster of
 machines (``dask scheduler`` and ``dask worker ADDRESS`` on each), a worker that dies has its task
@@ -62,18 +62,6 @@ def cluster_workers(scheduler):
             client.close()
 
 
-def merged_point_ids(xyz, input_points, pieces):
-    """out_of_core.h ``merged_point_ids``: each point's id in the merged mesh (the input points
-    the pieces use, in input order, then every cap point), -1 for an unused input point."""
-    used = np.zeros(len(xyz), dtype=bool)
-    for piece in pieces:
-        used[piece.ravel()] = True
-    used[input_points:] = True
-    ids = np.full(len(xyz), -1, dtype=np.int64)
-    ids[used] = np.arange(int(used.sum()))
-    return ids
-
-
 def mesh_pieces_on_cluster(surface, max_piece_triangles, scheduler, options, progress=None, cancel=None):
     """The solid bounded by ``surface`` (checked) in pieces of at most ``max_piece_triangles``
     triangles, meshed on the cluster of ``scheduler``. Returns ``(TetMesh, stats)``, stats as
@@ -85,9 +73,9 @@ def mesh_pieces_on_cluster(surface, max_piece_triangles, scheduler, options, pro
         if progress is not None:
             progress("cutting into pieces", 0.0)
         with core_errors(surface, "pieces mesher"):
-            xyz, pieces, stats = lib.cut_into_pieces(surface.points, surface.triangles,
-                                                     max_piece_triangles, cancel=cancel, workers=2)
-        ids = merged_point_ids(xyz, len(surface.points), pieces)
+            xyz, pieces, ids, stats = lib.cut_into_pieces(surface.points, surface.triangles,
+                                                          max_piece_triangles, cancel=cancel, workers=2)
+        started = time.perf_counter()
         futures, globals_of = [], []
         for k, piece in enumerate(pieces):
             globals_, local = np.unique(piece, return_inverse=True)
@@ -121,5 +109,6 @@ def mesh_pieces_on_cluster(surface, max_piece_triangles, scheduler, options, pro
             client.close()
     mesh = TetMesh(np.concatenate(points), np.concatenate(tets).astype(np.int64), surface.source)
     stats.update({"points": len(mesh.points), "tets": len(mesh.tets), "steiner_points": steiner,
+                  "seconds_meshing": time.perf_counter() - started,
                   "pieces_checked": True})
     return mesh, stats

@@ -130,6 +130,27 @@ void run_without_gil(Options& o, const py::object& progress, const py::object& c
   o.progress = nullptr;
 }
 
+// The statistics dict of a run in pieces (out_of_core.h PieceStats).
+py::dict piece_stats_dict(const PieceStats& ps, std::int64_t max_piece_triangles) {
+  py::dict d;
+  d["pieces"] = ps.pieces;
+  d["cuts"] = ps.cuts;
+  d["cuts_refused"] = ps.cuts_refused;
+  d["cap_triangles"] = ps.cap_triangles;
+  d["cap_points"] = ps.cap_points;
+  d["largest_piece_triangles"] = ps.largest_piece_triangles;
+  d["max_piece_triangles"] = max_piece_triangles;
+  d["points"] = ps.points;
+  d["tets"] = ps.tets;
+  d["steiner_points"] = ps.steiner_points;
+  d["pieces_checked"] = ps.pieces_checked;
+  d["seconds_cutting"] = ps.seconds_cutting;
+  d["seconds_meshing"] = ps.seconds_meshing;
+  d["seconds_writing"] = ps.seconds_writing;
+  d["uncut"] = ps.uncut;
+  return d;
+}
+
 // The core options the bindings share (MeshOptions::seed, steiner_effort), validated.
 MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effort) {
   MeshOptions o;
@@ -294,23 +315,7 @@ PYBIND11_MODULE(_bsptet, m) {
         po.workers = workers;
         PieceStats ps;
         run_without_gil(o, progress, cancel, [&]() { tetrahedralize_in_pieces(s, o, po, stem, &ps); });
-        py::dict d;
-        d["pieces"] = ps.pieces;
-        d["cuts"] = ps.cuts;
-        d["cuts_refused"] = ps.cuts_refused;
-        d["cap_triangles"] = ps.cap_triangles;
-        d["cap_points"] = ps.cap_points;
-        d["largest_piece_triangles"] = ps.largest_piece_triangles;
-        d["max_piece_triangles"] = max_piece_triangles;
-        d["points"] = ps.points;
-        d["tets"] = ps.tets;
-        d["steiner_points"] = ps.steiner_points;
-        d["pieces_checked"] = ps.pieces_checked;
-        d["seconds_cutting"] = ps.seconds_cutting;
-        d["seconds_meshing"] = ps.seconds_meshing;
-        d["seconds_writing"] = ps.seconds_writing;
-        d["uncut"] = ps.uncut;
-        return d;
+        return piece_stats_dict(ps, max_piece_triangles);
       },
       py::arg("points"), py::arg("triangles"), py::arg("stem"), py::arg("max_piece_triangles"),
       py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
@@ -342,22 +347,17 @@ PYBIND11_MODULE(_bsptet, m) {
           std::copy(piece.begin(), piece.end(), a.mutable_data());
           pieces.append(a);
         }
-        py::dict d;
-        d["pieces"] = ps.pieces;
-        d["cuts"] = ps.cuts;
-        d["cuts_refused"] = ps.cuts_refused;
-        d["cap_triangles"] = ps.cap_triangles;
-        d["cap_points"] = ps.cap_points;
-        d["largest_piece_triangles"] = ps.largest_piece_triangles;
-        d["max_piece_triangles"] = max_piece_triangles;
-        d["seconds_cutting"] = ps.seconds_cutting;
-        d["uncut"] = ps.uncut;
-        return py::make_tuple(xyz, pieces, d);
+        const std::vector<Index> ids = merged_point_ids(solid);
+        py::array_t<std::int64_t> merged_ids(static_cast<py::ssize_t>(ids.size()));
+        std::copy(ids.begin(), ids.end(), merged_ids.mutable_data());
+        return py::make_tuple(xyz, pieces, merged_ids, piece_stats_dict(ps, max_piece_triangles));
       },
       py::arg("points"), py::arg("triangles"), py::arg("max_piece_triangles"), py::arg("cancel") = py::none(),
       py::arg("workers") = 1,
-      "Step 1 of tetrahedralize_in_pieces (out_of_core.h cut_into_pieces): returns (xyz, pieces, stats), "
-      "xyz the input points then the caps' own points, pieces a list of (k, 3) triangle arrays over xyz.");
+      "Step 1 of tetrahedralize_in_pieces (out_of_core.h cut_into_pieces): returns (xyz, pieces, "
+      "merged_ids, stats), xyz the input points then the caps' own points, pieces a list of (k, 3) "
+      "triangle arrays over xyz, merged_ids each xyz point's id in the merged mesh (merged_point_ids; "
+      "-1: unused), stats those of tetrahedralize_in_pieces with the cutting figures filled.");
   m.def(
       "mesh_piece",
       [](const DoubleArray& points, const IndexArray& triangles, const std::string& name, bool check,

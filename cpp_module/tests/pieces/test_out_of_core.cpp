@@ -104,13 +104,18 @@ void expect_sound_cut(const SurfaceMesh& s, const SolidCut& cut) {
   EXPECT_EQ(static_cast<std::int64_t>(caps), cut.cap_triangles);
 }
 
-// Meshes `s` in pieces of at most `max` triangles into `stem`, reads the mesh back and checks it
-// exactly against the input surface.
-MeshCheckReport mesh_in_pieces(const SurfaceMesh& s, std::int64_t max, const std::string& stem, PieceStats* ps) {
+// Pieces of at most `max` triangles, cut down to 100.
+PieceOptions pieces_of_at_most(std::int64_t max) {
   PieceOptions po;
   po.max_piece_triangles = max;
   po.min_piece_triangles = 100;
-  tetrahedralize_in_pieces(s, MeshOptions{}, po, stem, ps);
+  return po;
+}
+
+// Meshes `s` in pieces of at most `max` triangles into `stem`, reads the mesh back and checks it
+// exactly against the input surface.
+MeshCheckReport mesh_in_pieces(const SurfaceMesh& s, std::int64_t max, const std::string& stem, PieceStats* ps) {
+  tetrahedralize_in_pieces(s, MeshOptions{}, pieces_of_at_most(max), stem, ps);
   return check_mesh(s, read_tetgen(stem));
 }
 
@@ -197,9 +202,7 @@ TEST(OutOfCore, TorusPiecesMergeIntoOneValidMesh) {
 
 TEST(OutOfCore, SameInputSameFilesAndNoScratchLeft) {
   const SurfaceMesh s = read_off(data("corpus/spot.off"));
-  PieceOptions po;
-  po.max_piece_triangles = 1500;
-  po.min_piece_triangles = 100;
+  const PieceOptions po = pieces_of_at_most(1500);
   const std::string a = scratch("det_a"), b = scratch("det_b");
   tetrahedralize_in_pieces(s, MeshOptions{}, po, a);
   tetrahedralize_in_pieces(s, MeshOptions{}, po, b);
@@ -216,9 +219,7 @@ TEST(OutOfCore, SameInputSameFilesAndNoScratchLeft) {
 // determinism), for every number of workers.
 TEST(OutOfCore, WorkersMeshThePiecesAtOnceIntoTheSameFiles) {
   const SurfaceMesh s = read_off(data("corpus/fertility.off"));
-  PieceOptions po;
-  po.max_piece_triangles = s.num_triangles() / 5;
-  po.min_piece_triangles = 100;
+  PieceOptions po = pieces_of_at_most(s.num_triangles() / 5);
   const std::string one = scratch("workers_1");
   PieceStats ps1;
   tetrahedralize_in_pieces(s, MeshOptions{}, po, one, &ps1);
@@ -246,9 +247,7 @@ TEST(OutOfCore, WorkersMeshThePiecesAtOnceIntoTheSameFiles) {
 // that meshes the pieces elsewhere runs them, give tetrahedralize_in_pieces's mesh.
 TEST(OutOfCore, TheStepsRunByHandGiveTheSameMesh) {
   const SurfaceMesh s = read_off(data("corpus/spot.off"));
-  PieceOptions po;
-  po.max_piece_triangles = 1500;
-  po.min_piece_triangles = 100;
+  const PieceOptions po = pieces_of_at_most(1500);
   const std::string stem = scratch("steps");
   tetrahedralize_in_pieces(s, MeshOptions{}, po, stem);
   const TetMesh whole = read_tetgen(stem);
@@ -283,9 +282,7 @@ TEST(OutOfCore, AStoppedRunLeavesThePreviousMeshAlone) {
   const std::string stem = scratch("stopped");
   std::ofstream(stem + ".node") << "previous node\n";
   std::ofstream(stem + ".ele") << "previous ele\n";
-  PieceOptions po;
-  po.max_piece_triangles = 1500;
-  po.min_piece_triangles = 100;
+  const PieceOptions po = pieces_of_at_most(1500);
   MeshOptions o;
   int pieces_started = 0;
   o.progress = [&](const std::string& stage, double) {
