@@ -90,9 +90,17 @@ std::int64_t MeshOptimizer::flip_pass(double below) {
       if (flip_failed_.failed_before(m_, t)) continue;
       bool done = false;
       const auto q = m_.tet(t);
+      // The shell sizes of the six edges, looked up once: nothing changes until an operation
+      // succeeds, and a 3-2 flip needs a shell of 3, an edge removal one of 4 to kMaxEdgeRing.
+      int shell[4][4] = {};
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          m_.tets_around_edge(q[i], q[j], shell_);
+          shell[i][j] = static_cast<int>(shell_.size());
+        }
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j)
-          if (m_.flip32(q[i], q[j])) {
+          if (shell[i][j] == 3 && m_.flip32(q[i], q[j])) {
             ++st_.flips32;
             done = true;
           }
@@ -103,7 +111,7 @@ std::int64_t MeshOptimizer::flip_pass(double below) {
         }
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j)
-          if (m_.remove_edge(q[i], q[j], kMaxEdgeRing, {}, 4)) {
+          if (shell[i][j] >= 4 && shell[i][j] <= kMaxEdgeRing && m_.remove_edge(q[i], q[j], kMaxEdgeRing, {}, 4)) {
             ++st_.edge_removals;
             done = true;
           }

@@ -312,16 +312,22 @@ EdgeKind RefineMesh::edge_kind(Index u, Index v, Index* tri_a, Index* tri_b) {
 }
 
 std::vector<std::array<Index, 2>> RefineMesh::edges() const {
+  // Point by point, from each point's ball: its larger neighbours, sorted. This gives the edges in
+  // sorted order without sorting all six edges of every tet.
   std::vector<std::array<Index, 2>> out;
-  out.reserve(static_cast<std::size_t>(alive_tets_) * 6);
-  for (Index t = 0; t < num_tet_slots(); ++t) {
-    if (!tet_alive(t)) continue;
-    const auto& q = tet(t);
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) out.push_back({std::min(q[i], q[j]), std::max(q[i], q[j])});
+  out.reserve(static_cast<std::size_t>(alive_tets_) * 7 / 5 + 16);
+  std::vector<Index> larger;
+  for (Index v = 0; v < num_points(); ++v) {
+    larger.clear();
+    for (Index t : ball_[static_cast<std::size_t>(v)]) {
+      if (!tet_alive(t)) continue;
+      for (Index w : tet(t))
+        if (w > v) larger.push_back(w);
+    }
+    std::sort(larger.begin(), larger.end());
+    larger.erase(std::unique(larger.begin(), larger.end()), larger.end());
+    for (Index w : larger) out.push_back({v, w});
   }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
@@ -666,10 +672,9 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
   };
   // Diagonals (i, j), j - i >= 2, (i, j) != (0, n - 1), must not be mesh edges yet (the caller
   // checked (0, n - 1) for an open chain); the single triangle of n = 3 must not be a mesh face.
-  std::vector<char> diagonal_ok(static_cast<std::size_t>(n * n), 1);
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 2; j < n; ++j)
-      if (!(i == 0 && j == n - 1)) diagonal_ok[static_cast<std::size_t>(i * n + j)] = !edge_exists(W(i), W(j));
+  // A diagonal is looked up only for a sub-polygon that has a triangulation good enough to be
+  // used (most have none), which gives the same optimum as checking every diagonal first.
+  const auto diagonal_ok = [&](int i, int j) { return (i == 0 && j == n - 1) || !edge_exists(W(i), W(j)); };
   if (n == 3)
     for (Index s : tets_around_edge(W(0), W(1)))
       if (std::find(tet(s).begin(), tet(s).end(), W(2)) != tet(s).end()) return false;
@@ -688,22 +693,22 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
       const int j = i + len;
       double b = floor_q;
       int c = -1;
-      if (diagonal_ok[static_cast<std::size_t>(i * n + j)])
-        for (int k = i + 1; k < j; ++k) {
-          const double left = best[static_cast<std::size_t>(i * n + k)], right = best[static_cast<std::size_t>(k * n + j)];
-          if (left <= kNone || right <= kNone) continue;
-          double q = std::min(left, right);
-          if (q <= b) continue;
-          for (const auto& t : tets_of(i, k, j)) {
-            if (!positive(t)) {
-              q = kNone;
-              break;
-            }
-            q = std::min(q, quality_of(t));
-            if (q <= b) break;
+      for (int k = i + 1; k < j; ++k) {
+        const double left = best[static_cast<std::size_t>(i * n + k)], right = best[static_cast<std::size_t>(k * n + j)];
+        if (left <= kNone || right <= kNone) continue;
+        double q = std::min(left, right);
+        if (q <= b) continue;
+        for (const auto& t : tets_of(i, k, j)) {
+          if (!positive(t)) {
+            q = kNone;
+            break;
           }
-          if (q > b) b = q, c = k;
+          q = std::min(q, quality_of(t));
+          if (q <= b) break;
         }
+        if (q > b) b = q, c = k;
+      }
+      if (c >= 0 && !diagonal_ok(i, j)) c = -1;
       best[static_cast<std::size_t>(i * n + j)] = c < 0 ? kNone : b;
       choice[static_cast<std::size_t>(i * n + j)] = c;
     }

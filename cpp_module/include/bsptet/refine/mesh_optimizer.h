@@ -163,6 +163,7 @@ class MeshOptimizer {
   RefineStats& st_;
   TargetSizes& size_;
   FailureMemory flip_failed_, insert_failed_;
+  std::vector<Index> shell_;  // flip_pass: scratch for a shell
 };
 
 }  // namespace bsptet
