@@ -20,13 +20,16 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // kPolishMaxRounds in all.
 constexpr int kPolishPatienceRounds = 4;
 constexpr int kPolishMaxRounds = 64;
+// lift first makes room for curved elements without a tet below this (or below the worst tet a
+// change replaces), then goes down to 1 degree.
+constexpr double kCurvingGoodDeg = 10.0;
 
 }  // namespace
 
 // Tries to make the invalid curved element t valid by changing the connectivity around it: 2-3
 // flips of its interior faces, 3-2 flips and removals of its interior edges, then collapses of
 // its interior Steiner corners onto a neighbour. A change is applied when it lowers the number of invalid
-// curved elements among the tets it replaces and none of its new tets is below min(1 degree,
+// curved elements among the tets it replaces and none of its new tets is below min(floor_deg_,
 // the worst old tet's) (as the lifts below). The surface never changes. True when one was made.
 template <class CurvedOk, class Corners>
 bool CurvedRoom::reconnect_for_curving(Index t, const CurvedOk& curved_ok, const Corners& corners) {
@@ -40,7 +43,7 @@ bool CurvedRoom::reconnect_for_curving(Index t, const CurvedOk& curved_ok, const
       bad_before += !curved_ok(r, P);
       worst_before = std::min(worst_before, tet_min_dihedral_deg(P[0], P[1], P[2], P[3]));
     }
-    const double floor_deg = std::min(1.0, worst_before);
+    const double floor_deg = std::min(floor_deg_, worst_before);
     int bad_after = 0;
     for (const auto& c : created) {
       const auto P = corners(c);
@@ -90,15 +93,27 @@ bool CurvedRoom::reconnect_for_curving(Index t, const CurvedOk& curved_ok, const
 // then has to move mid-nodes or insert a point, tet10.h). Such apexes (interior Steiner points only) are lifted towards
 // the height of a regular tet over the face, when every tet around stays positive (exact), the
 // number of invalid curved elements around goes down, and no tet around drops below
-// min(1 degree, the worst before): a valid curved mesh is worth a worse linear angle there.
+// min(floor_deg_, the worst before): a valid curved mesh is worth a worse linear angle there.
 // Failing that, a new interior point above one of the tet's faces (Bowyer-Watson), accepted when
-// all its new tets are valid curved elements of at least 1 degree. Splitting the sagging edges
+// all its new tets are valid curved elements of at least floor_deg_. All this runs twice: first
+// with floor_deg_ = kCurvingGoodDeg, then with 1 degree for the elements that first pass left
+// (t20_data: taking the first change down to 1 degree left a 3.3 degree tet where it need not
+// have, and the mesh ended at 5.7 degrees; with the two passes, 8.6). Splitting the sagging edges
 // instead was tried and made more invalid elements (docs/design/quality-stage.md). Sets
 // curving_conflicts_left.
 void CurvedRoom::lift() {
   if (!o_.projection || o_.order != 2) return;
-  constexpr auto& kFace = kTetOppositeFace;  // types.h
   prepare_check();
+  // First no new tet below kCurvingGoodDeg (or the worst a change replaces); then down to
+  // 1 degree for what that left.
+  for (double floor_deg : {kCurvingGoodDeg, 1.0}) {
+    floor_deg_ = floor_deg;
+    lift_rounds();
+  }
+}
+
+void CurvedRoom::lift_rounds() {
+  constexpr auto& kFace = kTetOppositeFace;  // types.h
   auto curved_ok = [&](const std::array<Index, 4>& q, const std::array<Vec3, 4>& P) {
     return element_ok(q, P);
   };
@@ -132,7 +147,7 @@ void CurvedRoom::lift() {
           bad_before += !curved_ok(m_.tet(s2), corners(m_.tet(s2)));
           worst_before = std::min(worst_before, m_.tet_quality(s2));
         }
-        const double floor_deg = std::min(1.0, worst_before);
+        const double floor_deg = std::min(floor_deg_, worst_before);
         // Targets in order: towards the apex of a regular tet over the face at 1, 0.75, 0.5,
         // 0.35 and 0.25 of its height, all the way or half way; then small lifts straight up
         // from the face's plane by 1, 3 or 7 times the apex's own height (over a long needle
@@ -170,7 +185,7 @@ void CurvedRoom::lift() {
         }
       }
       // Else a new interior point above each face of the tet, Bowyer-Watson, accepted when its
-      // new tets are all valid curved elements of at least 1 degree.
+      // new tets are all valid curved elements of at least floor_deg_.
       for (int k = 0; k < 4 && !done; ++k) {
         const Vec3& D = m_.point(q[k]);
         FaceFrame fr;
@@ -180,7 +195,7 @@ void CurvedRoom::lift() {
         auto accept = [&](const std::vector<std::array<Index, 4>>& cone, const Vec3& p) {
           for (const auto& c4 : cone) {
             const std::array<Vec3, 4> P{m_.point(c4[0]), m_.point(c4[1]), m_.point(c4[2]), p};
-            if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) < 1.0 || !curved_ok(c4, P)) return false;
+            if (tet_min_dihedral_deg(P[0], P[1], P[2], P[3]) < floor_deg_ || !curved_ok(c4, P)) return false;
           }
           return true;
         };

@@ -13,7 +13,8 @@
 //    MeshOptimizer of the stage; all must outlive it.
 //  * lift() does nothing without a hook or with order 1. Else it lifts interior points, changes
 //    connectivity or inserts interior points so that fewer curved elements are invalid, accepting
-//    new tets down to min(1 degree, the worst they replace); polish(below) then raises the tets
+//    new tets down to min(10 degrees, the worst they replace), then, for what that leaves, down
+//    to min(1 degree, the worst they replace); polish(below) then raises the tets
 //    below `below` degrees, never lowering the worst tet a change replaces and never making more
 //    curved elements invalid than it removes, so it never lowers the mesh's worst angle.
 //  * After either the linear mesh is valid (mesh_check.h), covers the same region and has the
@@ -53,6 +54,7 @@ class CurvedRoom {
   bool element_ok(const std::array<Index, 4>& q, const std::array<Vec3, 4>& P);
 
  private:
+  void lift_rounds();
   bool insert_keeping_curved(Index t);
   bool move_keeping_curved(Index v);
   template <class CurvedOk, class Corners>
@@ -65,6 +67,7 @@ class CurvedRoom {
   MeshOptimizer& opt_;
   std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> edge_tags_;  // prepare_check
   std::map<std::array<Index, 2>, Vec3> projected_;  // hook results at boundary edge midpoints
+  double floor_deg_ = 1.0;  // lift: no new tet below min(this, the worst it replaces)
 };
 
 }  // namespace bsptet
