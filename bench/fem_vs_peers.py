@@ -632,6 +632,7 @@ def median_ratios(results, divisions, peer):
 
 def mesher_medians(results, divisions, meshers):
     """{(D, mesher): (successes, attempts, median min dihedral, median 1% dihedral,
+    median of the per-tet median, meshes with a min dihedral of 10 degrees or more,
     parts with a bad Jacobian, median max distance / h)}."""
     out = {}
     for d in divisions:
@@ -644,6 +645,8 @@ def mesher_medians(results, divisions, meshers):
             out[(d, m)] = (len(ok), len(cases),
                            float(np.median([r["min_dihedral"] for r in rows])) if rows else None,
                            float(np.median([r["p1_dihedral"] for r in rows])) if rows else None,
+                           float(np.median([r["median_dihedral"] for r in rows])) if rows else None,
+                           sum(1 for r in rows if r["min_dihedral"] >= 10),
                            sum(1 for r in rows if r["bad_jacobian"] > 0),
                            float(np.median(dist)) if dist else None)
     return out
@@ -657,11 +660,12 @@ def print_summary(results, args):
         for d, (med, n) in median_ratios(results, args.divisions, peer).items():
             print("  D=%g ours/%s over %d parts: %s" % (d, peer, n, ", ".join(
                 "%s %s" % (label, fmt(med[k], ".2f")) for k, label in RATIO_KEYS)))
-    for (d, m), (ok, n, mn, p1, bad, dist) in mesher_medians(results, args.divisions,
-                                                             args.meshers).items():
-        print("  D=%g %-6s ok %d/%d, median min° %s, median 1%%° %s, parts with bad J %d, "
-              "median max dist/h %s" % (d, m, ok, n, fmt(mn, ".2f"), fmt(p1, ".1f"), bad,
-                                        fmt(dist, ".2e")))
+    for (d, m), (ok, n, mn, p1, md, good, bad, dist) in mesher_medians(
+            results, args.divisions, args.meshers).items():
+        print("  D=%g %-6s ok %d/%d, median min° %s, median 1%%° %s, median median° %s, "
+              "min >= 10° %d/%d, parts with bad J %d, median max dist/h %s"
+              % (d, m, ok, n, fmt(mn, ".2f"), fmt(p1, ".1f"), fmt(md, ".2f"), good, ok, bad,
+                 fmt(dist, ".2e")))
 
 
 # --- report and pictures --------------------------------------------------------------------------
@@ -844,11 +848,12 @@ def summary_markdown(results, args):
     if rows:
         out += [md_table(["ratio", "D", "parts (both ran)", "tets", "seconds", "peak MB"], rows),
                 ""]
-    rows = [[m, "%g" % d, "%d/%d" % (ok, n), fmt(mn, ".2f"), fmt(p1, ".1f"), bad, fmt(dist, ".2e")]
-            for (d, m), (ok, n, mn, p1, bad, dist) in mesher_medians(
+    rows = [[m, "%g" % d, "%d/%d" % (ok, n), fmt(mn, ".2f"), fmt(p1, ".1f"), fmt(md, ".2f"),
+             "%d/%d" % (good, ok), bad, fmt(dist, ".2e")]
+            for (d, m), (ok, n, mn, p1, md, good, bad, dist) in mesher_medians(
                 results, args.divisions, args.meshers).items()]
-    out += [md_table(["mesher", "D", "meshed", "median min°", "median 1%°",
-                      "parts with bad J", "median max dist / h"], rows), ""]
+    out += [md_table(["mesher", "D", "meshed", "median min°", "median 1%°", "median median°",
+                      "min ≥ 10°", "parts with bad J", "median max dist / h"], rows), ""]
     return out
 
 
