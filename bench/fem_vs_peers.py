@@ -1018,11 +1018,25 @@ def parse_args(argv):
     return args
 
 
+def without_workdir(argv):
+    """The command line as the report gives it: --workdir names a folder of this machine and
+    changes no figure."""
+    out, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == "--workdir":
+            skip = True
+        elif not a.startswith("--workdir="):
+            out.append(a)
+    return out
+
+
 def main(argv):
     if argv[:1] == ["--worker"]:
         return run_worker(argv[1:])
     args = parse_args(argv)
-    command = "bench/fem_vs_peers.py " + " ".join(shlex.quote(a) for a in argv)
+    command = "bench/fem_vs_peers.py " + " ".join(shlex.quote(a) for a in without_workdir(argv))
     started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     t0 = time.perf_counter()
     workdir = args.workdir or tempfile.mkdtemp(prefix="fem-vs-peers-")

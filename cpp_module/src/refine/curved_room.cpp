@@ -98,7 +98,7 @@ bool CurvedRoom::reconnect_for_curving(Index t, const CurvedOk& curved_ok, const
 // all its new tets are valid curved elements of at least floor_deg_. All this runs twice: first
 // with floor_deg_ = kCurvingGoodDeg, then with 1 degree for the elements that first pass left
 // (t20_data: taking the first change down to 1 degree left a 3.3 degree tet where it need not
-// have, and the mesh ended at 5.7 degrees; with the two passes, 8.6). Splitting the sagging edges
+// have, and the mesh ended at 5.7 degrees; with the two passes, 8 to 9). Splitting the sagging edges
 // instead was tried and made more invalid elements (docs/design/quality-stage.md). Sets
 // curving_conflicts_left.
 void CurvedRoom::lift() {
