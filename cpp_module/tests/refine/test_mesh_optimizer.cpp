@@ -105,9 +105,15 @@ TEST(MeshOptimizer, OdtSmoothingKeepsTetsAboveFifteenDegreesOrTheWorst) {
   Refined box(0.15);
   const mpq_class volume = box.volume6();
   const double before = box.worst();
-  const std::int64_t moves = box.opt->odt_smooth_pass();
+  const std::int64_t moves = box.opt->odt_smooth_pass(1);
   EXPECT_GT(moves, 0);
   EXPECT_EQ(box.st.relocations, moves);
+  EXPECT_TRUE(box.valid());
+  EXPECT_EQ(box.volume6(), volume);
+  EXPECT_GE(box.worst(), std::min(before, 15.0));
+  // Further sweeps visit only the neighbours of moved points, and still keep the bound.
+  const std::int64_t more = box.opt->odt_smooth_pass(3);
+  EXPECT_EQ(box.st.relocations, moves + more);
   EXPECT_TRUE(box.valid());
   EXPECT_EQ(box.volume6(), volume);
   EXPECT_GE(box.worst(), std::min(before, 15.0));

@@ -122,8 +122,9 @@ class MeshOptimizer {
   std::int64_t collapse_pass();
   /// Collapses Steiner corners of the tets below `below` degrees whatever their edge lengths.
   std::int64_t flat_collapse_pass(double below);
-  /// ODT smoothing of every interior point.
-  std::int64_t odt_smooth_pass();
+  /// ODT smoothing: a sweep over every interior point, then up to sweeps - 1 more over the
+  /// neighbours of the points the previous sweep moved.
+  std::int64_t odt_smooth_pass(int sweeps);
   /// Moves the interior corners of the tets below `below` degrees (smooth_point).
   std::int64_t smooth_pass(double below);
   /// A new interior point for each tet below `below` degrees where one raises the worst angle.
