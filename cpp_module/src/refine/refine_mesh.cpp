@@ -242,6 +242,13 @@ Index RefineMesh::add_tet(const std::array<Index, 4>& t) {
 void RefineMesh::kill_tet(Index t) {
   tet_alive_[static_cast<std::size_t>(t)] = 0;
   touch(tets_[static_cast<std::size_t>(t)]);
+  // Out of its corners' balls at once (their order kept): balls are read far more often than
+  // tets die.
+  for (Index v : tets_[static_cast<std::size_t>(t)]) {
+    auto& b = ball_[static_cast<std::size_t>(v)];
+    const auto it = std::find(b.begin(), b.end(), t);
+    if (it != b.end()) b.erase(it);
+  }
   --alive_tets_;
 }
 
@@ -259,11 +266,7 @@ double RefineMesh::quality_of(const std::array<Index, 4>& t) const {
   return tet_min_dihedral_deg(point(t[0]), point(t[1]), point(t[2]), point(t[3]));
 }
 
-const std::vector<Index>& RefineMesh::tets_around_point(Index v) {
-  auto& b = ball_[static_cast<std::size_t>(v)];
-  b.erase(std::remove_if(b.begin(), b.end(), [&](Index t) { return !tet_alive(t); }), b.end());
-  return b;
-}
+const std::vector<Index>& RefineMesh::tets_around_point(Index v) { return ball_[static_cast<std::size_t>(v)]; }
 
 void RefineMesh::tets_around_edge(Index u, Index v, std::vector<Index>& out) {
   out.clear();

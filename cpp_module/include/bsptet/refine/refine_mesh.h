@@ -269,7 +269,7 @@ class RefineMesh {
   std::vector<std::array<Index, 4>> tets_;
   std::vector<char> tet_alive_;
   std::vector<double> quality_;
-  std::vector<std::vector<Index>> ball_;  ///< point -> tets (dead ids removed lazily)
+  std::vector<std::vector<Index>> ball_;  ///< point -> its live tets, in increasing id order
   /// neighbour(t, k) cached at 4 t + k: kUnknownNeighbour, -1 (boundary) or a tet, valid while
   /// it is alive.
   static constexpr Index kUnknownNeighbour = -2;
