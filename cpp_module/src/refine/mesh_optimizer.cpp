@@ -224,75 +224,75 @@ std::int64_t MeshOptimizer::odt_smooth_pass(int sweeps) {
   const std::size_t np = static_cast<std::size_t>(m_.num_points());
   std::vector<char> active(np, 1), next(np, 0);
   for (int sweep = 0; sweep < sweeps; ++sweep) {
-    bool any = false;
-    for (Index v = 0; v < m_.num_points(); ++v) {
-      if (!active[static_cast<std::size_t>(v)]) continue;
-      if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) continue;
-      const std::vector<Index> ball = m_.tets_around_point(v);
-      if (ball.empty()) continue;
-      double wsum = 0, mean_before = 0, worst_before = 180;
-      Vec3 x{0, 0, 0};
-      bool ok = true;
-      for (Index t : ball) {
-        const auto P = corner_points(m_, m_.tet(t));
-        Vec3 c;
-        double r2 = 0;
-        if (!tet_circumsphere(P[0], P[1], P[2], P[3], &c, &r2)) {
-          ok = false;
-          break;
-        }
-        const double ux = P[1].x - P[0].x, uy = P[1].y - P[0].y, uz = P[1].z - P[0].z;
-        const double wx = P[2].x - P[0].x, wy = P[2].y - P[0].y, wz = P[2].z - P[0].z;
-        const double dx = P[3].x - P[0].x, dy = P[3].y - P[0].y, dz = P[3].z - P[0].z;
-        const double vol = std::abs(dx * (uy * wz - uz * wy) + dy * (uz * wx - ux * wz) + dz * (ux * wy - uy * wx));
-        x.x += vol * c.x, x.y += vol * c.y, x.z += vol * c.z;
-        wsum += vol;
-        mean_before += m_.tet_quality(t);
-        worst_before = std::min(worst_before, m_.tet_quality(t));
-      }
-      if (!ok || !(wsum > 0)) continue;
-      x = {x.x / wsum, x.y / wsum, x.z / wsum};
-      mean_before /= static_cast<double>(ball.size());
-      const double keep = std::min(worst_before, kOdtKeepDeg);
-      const MoveAccept accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
-        double mean = 0;
-        for (const auto& P : moved) {
-          const double q = tet_min_dihedral_deg(P[0], P[1], P[2], P[3]);
-          if (q < keep) return false;
-          mean += q;
-        }
-        return mean / static_cast<double>(moved.size()) > mean_before + 1e-9;
-      };
-      // Then the centroid of its neighbours (Laplacian smoothing), where the ODT point is refused:
-      // next to the surface the ODT point is pulled by the large circumspheres of the boundary
-      // tets, while the centroid still evens the ball out (on the CAD corpus the median per-tet
-      // worst angle rose by about 0.3 degree with it).
-      Vec3 centroid{0, 0, 0};
-      int k = 0;
-      for (Index t : ball)
-        for (Index w : m_.tet(t))
-          if (w != v) centroid.x += m_.point(w).x, centroid.y += m_.point(w).y, centroid.z += m_.point(w).z, ++k;
-      centroid = {centroid.x / k, centroid.y / k, centroid.z / k};
-      const Vec3 p = m_.point(v);
-      bool moved = false;
-      for (const Vec3& y : {x, centroid})
-        for (double f : {1.0, 0.5})
-          if (!moved && m_.relocate_point_if(v, {p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)}, accept)) {
-            ++n;
-            moved = true;
-          }
-      if (moved) {
-        any = true;
-        for (Index t : ball)
-          for (Index w : m_.tet(t)) next[static_cast<std::size_t>(w)] = 1;
-      }
-    }
+    std::int64_t moved = 0;
+    for (Index v = 0; v < m_.num_points(); ++v)
+      if (active[static_cast<std::size_t>(v)] && odt_move(v, &next)) ++moved;
+    n += moved;
+    if (moved == 0) break;
     active.swap(next);
     std::fill(next.begin(), next.end(), 0);
-    if (!any) break;
   }
   st_.relocations += n;
   return n;
+}
+
+// One point's move of odt_smooth_pass; marks the corners of its tets in moved_near when it moves.
+bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
+  if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
+  const std::vector<Index> ball = m_.tets_around_point(v);
+  if (ball.empty()) return false;
+  double wsum = 0, mean_before = 0, worst_before = 180;
+  Vec3 x{0, 0, 0};
+  bool ok = true;
+  for (Index t : ball) {
+    const auto P = corner_points(m_, m_.tet(t));
+    Vec3 c;
+    double r2 = 0;
+    if (!tet_circumsphere(P[0], P[1], P[2], P[3], &c, &r2)) {
+      ok = false;
+      break;
+    }
+    const double ux = P[1].x - P[0].x, uy = P[1].y - P[0].y, uz = P[1].z - P[0].z;
+    const double wx = P[2].x - P[0].x, wy = P[2].y - P[0].y, wz = P[2].z - P[0].z;
+    const double dx = P[3].x - P[0].x, dy = P[3].y - P[0].y, dz = P[3].z - P[0].z;
+    const double vol = std::abs(dx * (uy * wz - uz * wy) + dy * (uz * wx - ux * wz) + dz * (ux * wy - uy * wx));
+    x.x += vol * c.x, x.y += vol * c.y, x.z += vol * c.z;
+    wsum += vol;
+    mean_before += m_.tet_quality(t);
+    worst_before = std::min(worst_before, m_.tet_quality(t));
+  }
+  if (!ok || !(wsum > 0)) return false;
+  x = {x.x / wsum, x.y / wsum, x.z / wsum};
+  mean_before /= static_cast<double>(ball.size());
+  const double keep = std::min(worst_before, kOdtKeepDeg);
+  const MoveAccept accept = [&](const std::vector<std::array<Vec3, 4>>& moved) {
+    double mean = 0;
+    for (const auto& P : moved) {
+      const double q = tet_min_dihedral_deg(P[0], P[1], P[2], P[3]);
+      if (q < keep) return false;
+      mean += q;
+    }
+    return mean / static_cast<double>(moved.size()) > mean_before + 1e-9;
+  };
+  // Then the centroid of its neighbours (Laplacian smoothing), where the ODT point is refused:
+  // next to the surface the ODT point is pulled by the large circumspheres of the boundary
+  // tets, while the centroid still evens the ball out (on the CAD corpus the median per-tet
+  // worst angle rose by about 0.3 degree with it).
+  Vec3 centroid{0, 0, 0};
+  int k = 0;
+  for (Index t : ball)
+    for (Index w : m_.tet(t))
+      if (w != v) centroid.x += m_.point(w).x, centroid.y += m_.point(w).y, centroid.z += m_.point(w).z, ++k;
+  centroid = {centroid.x / k, centroid.y / k, centroid.z / k};
+  const Vec3 p = m_.point(v);
+  for (const Vec3& y : {x, centroid})
+    for (double f : {1.0, 0.5})
+      if (m_.relocate_point_if(v, {p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)}, accept)) {
+        for (Index t : ball)
+          for (Index w : m_.tet(t)) (*moved_near)[static_cast<std::size_t>(w)] = 1;
+        return true;
+      }
+  return false;
 }
 
 // Moves interior points towards the centroid of their neighbours when it helps the worst tet.

@@ -135,6 +135,9 @@ class MeshOptimizer {
   std::int64_t radius_edge_pass();
 
   // ---- Single operations ----
+  /// odt_smooth_pass's move of interior point v (the ODT point, else its neighbours' centroid);
+  /// when it moves, sets moved_near[w] for every corner w of its tets. True when v moved.
+  bool odt_move(Index v, std::vector<char>* moved_near);
   /// Moves interior point v to the first position that raises the worst tet around it; true when
   /// it moved.
   bool smooth_point(Index v);
