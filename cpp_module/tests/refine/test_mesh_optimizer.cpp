@@ -177,3 +177,31 @@ TEST(FailureMemory, ForgetsATetWhenATetAroundItsCornersChanges) {
   }
   EXPECT_GT(retried, 0);
 }
+
+// The balls (RefineMesh::tets_around_point) and the edge list (RefineMesh::edges) against the
+// live tets counted by brute force, after passes that flip, collapse and move: each ball holds
+// exactly the live tets at its point in increasing id order (a tet leaves them when it dies),
+// and edges() is every edge of a live tet once, sorted.
+TEST(MeshOptimizer, BallsAndEdgesFollowTheLiveTetsThroughThePasses) {
+  Refined box(0.15);
+  box.opt->flip_pass(40.0);
+  box.opt->collapse_pass();
+  box.opt->flat_collapse_pass(1.0);
+  box.opt->odt_smooth_pass(2);
+  RefineMesh& m = *box.m;
+  std::vector<std::vector<Index>> balls(static_cast<std::size_t>(m.num_points()));
+  std::vector<std::array<Index, 2>> edges;
+  for (Index t = 0; t < m.num_tet_slots(); ++t) {
+    if (!m.tet_alive(t)) continue;
+    const auto& q = m.tet(t);
+    for (int i = 0; i < 4; ++i) {
+      balls[static_cast<std::size_t>(q[i])].push_back(t);
+      for (int j = i + 1; j < 4; ++j) edges.push_back({std::min(q[i], q[j]), std::max(q[i], q[j])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  EXPECT_EQ(m.edges(), edges);
+  for (Index v = 0; v < m.num_points(); ++v) EXPECT_EQ(m.tets_around_point(v), balls[static_cast<std::size_t>(v)]) << v;
+  EXPECT_GT(box.st.collapses + box.st.flips23 + box.st.flips32 + box.st.edge_removals, 0);
+}
