@@ -150,8 +150,11 @@ def test_optimization_rounds_do_not_grow_the_mesh_without_raising_its_angles(nam
     native = core.native()
     results = {}
     for rounds in (1, 8):
+        options = native.RefineOptions()
+        options.size = diag(surface) / 20
+        options.optimize_rounds = rounds
         points, tets, st = native.refine(surface.points, surface.triangles, None, mesh.points,
-                                         mesh.tets, size=diag(surface) / 20, optimize_rounds=rounds)
+                                         mesh.tets, options=options)
         refined = core.TetMesh(points, tets, surface.source)
         report = core.check_mesh(surface, refined)
         assert report["valid"], report["messages"]
@@ -328,3 +331,4 @@ def test_thin_wall_sizing_refines_across_a_hollow_sphere():
     assert rf["quality"]["min_dihedral_deg"] < 3
     assert rw["quality"]["min_dihedral_deg"] > 5.74
     assert np.median(edge_lengths(walls)) < 0.5 * np.median(edge_lengths(flat))
+

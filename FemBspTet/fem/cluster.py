@@ -31,7 +31,7 @@ def mesh_piece_task(points, triangles, name, core_options):
     """Runs on a worker: one piece's surface meshed by the core and checked exactly. Returns the
     Steiner points (the piece's own points come first in the core's mesh and are left out) and
     the tets over the piece's points then those Steiner points."""
-    mesh_points, tets = native().mesh_piece(points, triangles, name, check=True, **core_options)
+    mesh_points, tets = native().mesh_piece(points, triangles, name, check=True, options=core_options)
     return mesh_points[len(points):], tets
 
 

@@ -166,7 +166,7 @@ def _mesh_checked(lib, checked, options, max_memory, workers, scheduler, max_pie
                 with core_errors(surface, "pieces mesher"):
                     pieces = lib.tetrahedralize_in_pieces(
                         surface.points, surface.triangles, stem, piece, progress=report,
-                        cancel=cancel, workers=workers, **native_core_options(options))
+                        cancel=cancel, workers=workers, options=native_core_options(options))
                 mesh = read_tetgen(stem)
                 os.remove(stem + ".node")
                 os.remove(stem + ".ele")

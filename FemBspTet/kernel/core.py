@@ -169,31 +169,27 @@ def to_second_order(mesh: TetMesh) -> TetMesh:
     return TetMesh(np.vstack([mesh.points, mids]), np.hstack([tets, mid_ids]), mesh.source, dict(mesh.extra))
 
 
-def _effort(options):
-    """The ``steiner_effort`` keyword for the native call (absent: the core's default)."""
-
-    effort = options.get("steiner_effort")
-    if effort is None:
-        return {}
-    if isinstance(effort, bool) or not isinstance(effort, int) or effort < 0:
-        raise InputError(f"steiner_effort must be an integer >= 0 (0: no bound), got {effort!r}")
-    return {"steiner_effort": effort}
-
-
 BSP_SEEDS = ("auto", "delaunay", "box")
 
 
 def native_core_options(options):
-    """Keywords for the native ``tetrahedralize``: ``steiner_effort`` and ``bsp_seed`` (absent:
-    the core's defaults)."""
+    """The native ``MeshOptions`` (core/mesher.h for_each_mesh_option) for ``options``:
+    ``allow_boundary_steiner``, ``steiner_effort`` and ``bsp_seed`` (absent: the core's
+    defaults)."""
 
-    kw = _effort(options)
+    native_options = native().MeshOptions()
+    native_options.allow_boundary_steiner = bool(options.get("allow_boundary_steiner", False))
+    effort = options.get("steiner_effort")
+    if effort is not None:
+        if isinstance(effort, bool) or not isinstance(effort, int) or effort < 0:
+            raise InputError(f"steiner_effort must be an integer >= 0 (0: no bound), got {effort!r}")
+        native_options.steiner_effort = effort
     seed = options.get("bsp_seed")
     if seed is not None:
         if seed not in BSP_SEEDS:
             raise InputError(f"bsp_seed must be one of {', '.join(BSP_SEEDS)}, got {seed!r}")
-        kw["bsp_seed"] = seed
-    return kw
+        native_options.seed = getattr(native().BspSeed, seed)
+    return native_options
 
 
 def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
@@ -265,10 +261,8 @@ def tetrahedralize(surfaces, options=None, progress=None, cancel=None):
 
         with core_errors(surface, "mesher"), _self_intersection_errors(originals[k]):
             points, tets, st = lib.tetrahedralize(
-                originals[k].points, originals[k].triangles,
-                allow_boundary_steiner=bool(options.get("allow_boundary_steiner", False)),
-                progress=report, cancel=cancel, check={"reorient": reorient},
-                **native_core_options(options))
+                originals[k].points, originals[k].triangles, options=native_core_options(options),
+                progress=report, cancel=cancel, check={"reorient": reorient})
         mesh = TetMesh(points, tets, surface.source)
         report_check = _checked(surface, mesh, "mesh")
         if refining or order == 2 or (separating and surface.face_tags is not None):
@@ -406,6 +400,11 @@ REFINE_OPTIONS = {
                           "membership (FreeCAD's CalculiX writer) load exactly the boundary faces",
 }
 
+#: The native RefineOptions field (quality_refine.h for_each_refine_option) of each Python option
+#: whose name differs; the other options of REFINE_OPTIONS are the field of that name, except
+#: ``projection``, a callback passed beside the options. A test checks this against the schema.
+REFINE_OPTION_OF = {"radius_edge": "radius_edge_bound", "min_dihedral": "min_dihedral_deg"}
+
 #: Every option name :func:`tetrahedralize` accepts.
 OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "bsp_seed", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
 
@@ -452,10 +451,6 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     order = int(options.get("order") or 1)
     if order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}")
-    extra = {}  # absent: the core's defaults (quality_refine.h)
-    if options.get("thickness_ratio") is not None:
-        extra["thickness_ratio"] = _positive_number("thickness_ratio", options["thickness_ratio"],
-                                                    allow_zero=True)
     mode = options.get("surface_points") or "exact"
     if mode not in ("exact", "rounded"):
         raise InputError(f"surface_points must be 'exact' or 'rounded', got {mode!r}")
@@ -465,15 +460,23 @@ def refine(surface: Surface, mesh: TetMesh, options=None, progress=None, cancel=
     only_order = (set(k for k, v in options.items() if v is not None)
                   <= {"order", "projection", "separate_face_tags", "thickness_ratio"})
     lib = native()
+    native_options = lib.RefineOptions()  # the core's defaults for what is not set here
+    values = {"size": size, "min_size": min_size, "size_by_tag": by_tag,
+              "radius_edge": radius_edge, "min_dihedral": min_dihedral, "order": order,
+              "surface_points": getattr(lib.SurfacePoints, mode),
+              "separate_face_tags": bool(options.get("separate_face_tags")),
+              "size_from_surface": bool(options.get("size_from_surface"))}
+    if options.get("thickness_ratio") is not None:
+        values["thickness_ratio"] = _positive_number("thickness_ratio", options["thickness_ratio"],
+                                                     allow_zero=True)
+    for name, value in values.items():
+        setattr(native_options, REFINE_OPTION_OF.get(name, name), value)
+    if only_order:
+        native_options.max_passes = 0  # no size passes: mid-edge nodes only
     with core_errors(surface, "refinement"):
         points, tets, st = lib.refine(
             surface.points, surface.triangles, surface.face_tags, mesh.points, mesh.tets[:, :4],
-            size=size, min_size=min_size, size_by_tag=by_tag, radius_edge=radius_edge,
-            min_dihedral=min_dihedral, order=order, surface_points_mode=mode,
-            projection=projection, max_passes=0 if only_order else 40, optimize_rounds=8,
-            separate_face_tags=bool(options.get("separate_face_tags")),
-            size_from_surface=bool(options.get("size_from_surface")), progress=progress,
-            cancel=cancel, **extra)
+            options=native_options, projection=projection, progress=progress, cancel=cancel)
     out = TetMesh(points, tets, mesh.source)
     exact = mode == "exact" and projection is None
     reference = surface if exact else boundary_surface(out)

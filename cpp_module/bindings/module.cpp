@@ -151,19 +151,9 @@ py::dict piece_stats_dict(const PieceStats& ps, std::int64_t max_piece_triangles
   return d;
 }
 
-// The core options the bindings share (MeshOptions::seed, steiner_effort), validated.
-MeshOptions core_options(const std::string& bsp_seed, std::int64_t steiner_effort) {
-  MeshOptions o;
-  if (bsp_seed == "auto")
-    o.seed = MeshOptions::Seed::kAuto;
-  else if (bsp_seed == "delaunay")
-    o.seed = MeshOptions::Seed::kDelaunay;
-  else if (bsp_seed == "box")
-    o.seed = MeshOptions::Seed::kBox;
-  else
-    throw py::value_error("bsp_seed must be 'auto', 'delaunay' or 'box', got '" + bsp_seed + "'");
-  if (steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
-  o.steiner_effort = steiner_effort;
+// MeshOptions as the bindings take it, refused when out of range.
+const MeshOptions& checked_core_options(const MeshOptions& o) {
+  if (o.steiner_effort < 0) throw py::value_error("steiner_effort must be >= 0 (0: no bound)");
   return o;
 }
 
@@ -262,15 +252,42 @@ PYBIND11_MODULE(_bsptet, m) {
     }
   });
 
+  {
+    // The core's options schema (core/mesher.h for_each_mesh_option), as a class; picklable (a
+    // cluster's workers get it with each piece).
+    py::enum_<MeshOptions::Seed>(m, "BspSeed", "What the BSP starts from (mesher.h MeshOptions::seed).")
+        .value("auto", MeshOptions::Seed::kAuto)
+        .value("delaunay", MeshOptions::Seed::kDelaunay)
+        .value("box", MeshOptions::Seed::kBox);
+    py::class_<MeshOptions> options(m, "MeshOptions", "Options of the exact core (mesher.h MeshOptions).");
+    options.def(py::init<>());
+    for_each_mesh_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
+    options.def_property_readonly_static("names", [](py::object) {
+      py::list names;
+      for_each_mesh_option([&](const char* name, auto) { names.append(name); });
+      return names;
+    });
+    options.def(py::pickle(
+        [](const MeshOptions& o) {
+          py::dict d;
+          for_each_mesh_option([&](const char* name, auto member) { d[name] = o.*member; });
+          return d;
+        },
+        [](const py::dict& d) {
+          MeshOptions o;
+          for_each_mesh_option([&](const char* name, auto member) {
+            if (d.contains(name)) o.*member = d[name].template cast<std::decay_t<decltype(o.*member)>>();
+          });
+          return o;
+        }));
+  }
+
   m.def(
       "tetrahedralize",
-      [](const DoubleArray& points, const IndexArray& triangles, bool allow_boundary_steiner, py::object progress,
-         py::object cancel, bool cone_cells, std::int64_t steiner_effort, const std::string& bsp_seed,
-         py::object check) {
+      [](const DoubleArray& points, const IndexArray& triangles, const MeshOptions& options, py::object progress,
+         py::object cancel, py::object check) {
         const SurfaceMesh s = surface_from(points, triangles);
-        MeshOptions o = core_options(bsp_seed, steiner_effort);
-        o.allow_boundary_steiner = allow_boundary_steiner;
-        o.cone_cells = cone_cells;
+        MeshOptions o = checked_core_options(options);
         TetMesh mesh;
         MeshStats st;
         if (check.is_none()) {
@@ -285,18 +302,15 @@ PYBIND11_MODULE(_bsptet, m) {
         py::dict d = mesh_stats_dict(st);
         return py::make_tuple(points_array(mesh), tets_array(mesh), d);
       },
-      py::arg("points"), py::arg("triangles"), py::arg("allow_boundary_steiner") = false,
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("cone_cells") = false,
-      py::arg("steiner_effort") = MeshOptions{}.steiner_effort,
-      py::arg("bsp_seed") = "auto", py::arg("check") = py::none(),
+      py::arg("points"), py::arg("triangles"), py::arg("options") = MeshOptions{},
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("check") = py::none(),
       "Tetrahedralizes the solid bounded by a closed triangle surface (see mesher.h). Returns "
       "(points (n, 3), tets (m, 4), stats dict). Raises InputError (bad surface) or MeshingError. "
-      "cone_cells: fill cells by cones (the filler before the per-cell Delaunay), for comparison. "
-      "steiner_effort: work (exact orientation tests, cavity growth) the core may spend removing one "
-      "interior Steiner point (0: no bound; MeshOptions::steiner_effort). "
-      "bsp_seed: 'auto' (default), 'delaunay' (the BSP starts from the Delaunay tetrahedralization of "
-      "the input points) or 'box' (one box cell, the paper's auto-partition); MeshOptions::seed; "
-      "stats['bsp_seed'] says which one the mesh came from. "
+      "options: a MeshOptions (allow_boundary_steiner; cone_cells: fill cells by cones, for comparison; "
+      "steiner_effort: work the core may spend removing one interior Steiner point, 0: no bound; seed: "
+      "BspSeed.auto, .delaunay (the BSP starts from the Delaunay tetrahedralization of the input points) "
+      "or .box (one box cell, the paper's auto-partition); stats['bsp_seed'] says which one the mesh "
+      "came from). "
       "check: None, or a dict (reorient, max_reported_pairs) to check the surface as check_surface "
       "does, its self-intersection search beside the core (mesher.h check_and_tetrahedralize; the mesh "
       "is made from the checked triangles, re-oriented when reorient is set).");
@@ -305,10 +319,10 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "tetrahedralize_in_pieces",
       [](const DoubleArray& points, const IndexArray& triangles, const std::string& stem,
-         std::int64_t max_piece_triangles, py::object progress, py::object cancel, std::int64_t steiner_effort,
-         const std::string& bsp_seed, bool check_pieces, int workers) {
+         std::int64_t max_piece_triangles, py::object progress, py::object cancel, const MeshOptions& options,
+         bool check_pieces, int workers) {
         const SurfaceMesh s = surface_from(points, triangles);
-        MeshOptions o = core_options(bsp_seed, steiner_effort);
+        MeshOptions o = checked_core_options(options);
         PieceOptions po;
         po.max_piece_triangles = max_piece_triangles;
         po.check_pieces = check_pieces;
@@ -318,8 +332,7 @@ PYBIND11_MODULE(_bsptet, m) {
         return piece_stats_dict(ps, max_piece_triangles);
       },
       py::arg("points"), py::arg("triangles"), py::arg("stem"), py::arg("max_piece_triangles"),
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-      py::arg("steiner_effort") = MeshOptions{}.steiner_effort, py::arg("bsp_seed") = "auto",
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(), py::arg("options") = MeshOptions{},
       py::arg("check_pieces") = true, py::arg("workers") = 1,
       "Meshes the solid bounded by a checked closed surface in pieces of at most max_piece_triangles "
       "triangles, `workers` of them at a time on threads, streaming the mesh to stem.node / stem.ele "
@@ -361,15 +374,15 @@ PYBIND11_MODULE(_bsptet, m) {
   m.def(
       "mesh_piece",
       [](const DoubleArray& points, const IndexArray& triangles, const std::string& name, bool check,
-         std::int64_t steiner_effort, const std::string& bsp_seed) {
+         const MeshOptions& options) {
         const SurfaceMesh s = surface_from(points, triangles);
-        MeshOptions o = core_options(bsp_seed, steiner_effort);
+        MeshOptions o = checked_core_options(options);
         TetMesh mesh;
         run_without_gil(o, py::none(), py::none(), [&]() { mesh = mesh_piece(s, o, check, name); });
         return py::make_tuple(points_array(mesh), tets_array(mesh));
       },
       py::arg("points"), py::arg("triangles"), py::arg("name"), py::arg("check") = true,
-      py::arg("steiner_effort") = MeshOptions{}.steiner_effort, py::arg("bsp_seed") = "auto",
+      py::arg("options") = MeshOptions{},
       "Step 2 of tetrahedralize_in_pieces (out_of_core.h mesh_piece) on a piece's own surface: returns "
       "(points, tets), the piece's points first, then its Steiner points; checked exactly with check.");
 
@@ -409,14 +422,28 @@ PYBIND11_MODULE(_bsptet, m) {
       "Checks a triangle surface before meshing (see surface_check.h). Returns (triangles (m, 3) with "
       "flipped ones reversed, info dict). Raises InputError naming the first problem.");
   // ---- Quality stage: refine_quality (quality_refine.h). ----
+  {
+    // The options schema (quality_refine.h for_each_refine_option), as a class.
+    py::enum_<SurfacePoints>(m, "SurfacePoints", "Where new surface points go without a projection hook "
+                                                 "(refine_mesh.h SurfacePoints).")
+        .value("exact", SurfacePoints::kExact)
+        .value("rounded", SurfacePoints::kRounded);
+    py::class_<RefineOptions> options(m, "RefineOptions",
+                                      "Options of the quality stage (quality_refine.h RefineOptions): size is "
+                                      "FreeCAD's CharacteristicLengthMax (infinity: none).");
+    options.def(py::init<>());
+    for_each_refine_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
+    options.def_property_readonly_static("names", [](py::object) {
+      py::list names;
+      for_each_refine_option([&](const char* name, auto) { names.append(name); });
+      return names;
+    });
+  }
   m.def(
       "refine",
       [](const DoubleArray& surface_points, const IndexArray& surface_triangles, py::object surface_tags,
-         const DoubleArray& points, const IndexArray& tets, double size, double min_size,
-         std::map<std::int32_t, double> size_by_tag, double radius_edge, double min_dihedral, int order,
-         const std::string& surface_points_mode, py::object projection, int max_passes, int optimize_rounds,
-         bool separate_face_tags, bool size_from_surface, double split_ratio, double collapse_ratio,
-         double thickness_ratio, py::object progress, py::object cancel) {
+         const DoubleArray& points, const IndexArray& tets, RefineOptions o, py::object projection,
+         py::object progress, py::object cancel) {
         SurfaceMesh s;
         s.xyz = points_from(surface_points, "surface_points");
         s.tri = indices_from(surface_triangles, "surface_triangles", 3);
@@ -427,23 +454,6 @@ PYBIND11_MODULE(_bsptet, m) {
           for (py::ssize_t i = 0; i < t.shape(0); ++i) s.tag.push_back(static_cast<std::int32_t>(t.data()[i]));
         }
         const TetMesh mesh = tetmesh_from(points, tets);
-        RefineOptions o;
-        o.size = size;
-        o.min_size = min_size;
-        o.size_by_tag = std::move(size_by_tag);
-        o.radius_edge_bound = radius_edge;
-        o.min_dihedral_deg = min_dihedral;
-        o.order = order;
-        o.max_passes = max_passes;
-        o.optimize_rounds = optimize_rounds;
-        o.separate_face_tags = separate_face_tags;
-        o.size_from_surface = size_from_surface;
-        o.split_ratio = split_ratio;
-        o.collapse_ratio = collapse_ratio;
-        o.thickness_ratio = thickness_ratio;
-        if (surface_points_mode == "exact") o.surface_points = SurfacePoints::kExact;
-        else if (surface_points_mode == "rounded") o.surface_points = SurfacePoints::kRounded;
-        else throw py::value_error("surface_points must be 'exact' or 'rounded', got '" + surface_points_mode + "'");
         if (!projection.is_none())
           o.projection = [projection](const Vec3& p, std::int32_t tag, std::int32_t other) {
             py::gil_scoped_acquire gil;
@@ -462,16 +472,11 @@ PYBIND11_MODULE(_bsptet, m) {
         return py::make_tuple(points_array(out), tets_array(out), d);
       },
       py::arg("surface_points"), py::arg("surface_triangles"), py::arg("surface_tags"), py::arg("points"),
-      py::arg("tets"), py::arg("size") = std::numeric_limits<double>::infinity(), py::arg("min_size") = 0.0,
-      py::arg("size_by_tag") = std::map<std::int32_t, double>{}, py::arg("radius_edge") = 0.0,
-      py::arg("min_dihedral") = 0.0, py::arg("order") = 1, py::arg("surface_points_mode") = "exact",
-      py::arg("projection") = py::none(), py::arg("max_passes") = 40, py::arg("optimize_rounds") = 8,
-      py::arg("separate_face_tags") = false, py::arg("size_from_surface") = false,
-      py::arg("split_ratio") = RefineOptions{}.split_ratio, py::arg("collapse_ratio") = RefineOptions{}.collapse_ratio,
-      py::arg("thickness_ratio") = RefineOptions{}.thickness_ratio, py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-      "Refines a valid tet mesh of a closed surface to a size and quality (see quality_refine.h). "
-      "projection(point (3,), tag, other_tag) -> point moves new surface points. Returns (points, tets "
-      "(m, 4) or (m, 10), stats dict).");
+      py::arg("tets"), py::arg("options") = RefineOptions{}, py::arg("projection") = py::none(),
+      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+      "Refines a valid tet mesh of a closed surface to a size and quality (see quality_refine.h); options: "
+      "a RefineOptions. projection(point (3,), tag, other_tag) -> point moves new surface points. Returns "
+      "(points, tets (m, 4) or (m, 10), stats dict).");
 
   // ---- Validity of 10-node tets (tet10.h). ----
   m.def(

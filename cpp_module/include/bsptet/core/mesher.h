@@ -92,6 +92,19 @@ struct MeshStats {
   double seconds_total = 0;
 };
 
+/// The options schema, stated once: calls f(name, member pointer) for every value option of
+/// MeshOptions (not the callbacks). The bindings bind MeshOptions from it.
+template <class F>
+void for_each_mesh_option(F&& f) {
+  f("allow_boundary_steiner", &MeshOptions::allow_boundary_steiner);
+  f("cone_cells", &MeshOptions::cone_cells);
+  f("covered_faces_along_lines", &MeshOptions::covered_faces_along_lines);
+  f("seed", &MeshOptions::seed);
+  f("bsp_candidate_shift", &MeshOptions::bsp_candidate_shift);
+  f("steiner_effort", &MeshOptions::steiner_effort);
+  f("debug_checks", &MeshOptions::debug_checks);
+}
+
 /// The statistics schema, stated once: calls f(key, member pointer) for every figure of
 /// MeshStats; the keys are those of the statistics JSON (the bindings add the keys computed from
 /// several fields: interior_steiner_points, bsp_seed).

@@ -170,6 +170,30 @@ struct RefineStats {
   std::map<std::string, double> seconds_by_pass;
 };
 
+/// The options schema, stated once: calls f(name, member pointer) for every value option of
+/// RefineOptions (not the hook and the callbacks). The bindings bind RefineOptions from it; the
+/// Python options (FemBspTet.kernel.core.REFINE_OPTIONS) are checked against it by a test.
+template <class F>
+void for_each_refine_option(F&& f) {
+  f("size", &RefineOptions::size);
+  f("min_size", &RefineOptions::min_size);
+  f("size_by_tag", &RefineOptions::size_by_tag);
+  f("size_from_surface", &RefineOptions::size_from_surface);
+  f("thickness_ratio", &RefineOptions::thickness_ratio);
+  f("grading", &RefineOptions::grading);
+  f("split_ratio", &RefineOptions::split_ratio);
+  f("collapse_ratio", &RefineOptions::collapse_ratio);
+  f("collapse_min_dihedral_deg", &RefineOptions::collapse_min_dihedral_deg);
+  f("radius_edge_bound", &RefineOptions::radius_edge_bound);
+  f("min_dihedral_deg", &RefineOptions::min_dihedral_deg);
+  f("separate_face_tags", &RefineOptions::separate_face_tags);
+  f("fixed_tags", &RefineOptions::fixed_tags);
+  f("order", &RefineOptions::order);
+  f("max_passes", &RefineOptions::max_passes);
+  f("optimize_rounds", &RefineOptions::optimize_rounds);
+  f("surface_points", &RefineOptions::surface_points);
+}
+
 /// The statistics schema, stated once: calls f(key, member pointer) for every figure of
 /// RefineStats; the keys are those of the statistics JSON.
 template <class F>
