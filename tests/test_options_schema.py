@@ -77,3 +77,15 @@ def test_refine_options_class_from_the_schema():
     o.order = 3
     with pytest.raises(ValueError, match="order"):
         lib.refine(surface.points, surface.triangles, None, mesh.points, mesh.tets, options=o)
+
+
+def test_every_python_option_maps_onto_a_schema_or_is_python_only():
+    """core.OPTION_NAMES (the options of tetrahedralize, which the CLI's flags fill): each is a
+    MeshOptions field, a RefineOptions field or one of the few handled in Python."""
+    lib = core.native()
+    mesh_names, refine_names = set(lib.MeshOptions.names), set(lib.RefineOptions.names)
+    assert set(core.MESH_OPTION_OF.values()) <= mesh_names
+    for name in core.OPTION_NAMES:
+        assert (name in core.MESH_OPTION_OF or core.REFINE_OPTION_OF.get(name, name) in refine_names
+                or name in core.PYTHON_OPTIONS), name
+

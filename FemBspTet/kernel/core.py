@@ -405,6 +405,14 @@ REFINE_OPTIONS = {
 #: ``projection``, a callback passed beside the options. A test checks this against the schema.
 REFINE_OPTION_OF = {"radius_edge": "radius_edge_bound", "min_dihedral": "min_dihedral_deg"}
 
+#: The native MeshOptions field (core/mesher.h for_each_mesh_option) of each core option of
+#: :func:`tetrahedralize`, as :func:`native_core_options` sets them.
+MESH_OPTION_OF = {"allow_boundary_steiner": "allow_boundary_steiner",
+                  "steiner_effort": "steiner_effort", "bsp_seed": "seed"}
+
+#: Options of :func:`tetrahedralize` handled in Python, not by a native options class.
+PYTHON_OPTIONS = ("reorient", "max_memory", "projection")
+
 #: Every option name :func:`tetrahedralize` accepts.
 OPTION_NAMES = ("allow_boundary_steiner", "steiner_effort", "bsp_seed", "order", "reorient", "max_memory") + tuple(REFINE_OPTIONS)
 
