@@ -177,18 +177,20 @@ def native_core_options(options):
     ``allow_boundary_steiner``, ``steiner_effort`` and ``bsp_seed`` (absent: the core's
     defaults)."""
 
-    native_options = native().MeshOptions()
-    native_options.allow_boundary_steiner = bool(options.get("allow_boundary_steiner", False))
+    values = {"allow_boundary_steiner": bool(options.get("allow_boundary_steiner", False))}
     effort = options.get("steiner_effort")
     if effort is not None:
         if isinstance(effort, bool) or not isinstance(effort, int) or effort < 0:
             raise InputError(f"steiner_effort must be an integer >= 0 (0: no bound), got {effort!r}")
-        native_options.steiner_effort = effort
+        values["steiner_effort"] = effort
     seed = options.get("bsp_seed")
     if seed is not None:
         if seed not in BSP_SEEDS:
             raise InputError(f"bsp_seed must be one of {', '.join(BSP_SEEDS)}, got {seed!r}")
-        native_options.seed = getattr(native().BspSeed, seed)
+        values["bsp_seed"] = getattr(native().BspSeed, seed)
+    native_options = native().MeshOptions()
+    for name, value in values.items():
+        setattr(native_options, MESH_OPTION_OF[name], value)
     return native_options
 
 
@@ -406,7 +408,7 @@ REFINE_OPTIONS = {
 REFINE_OPTION_OF = {"radius_edge": "radius_edge_bound", "min_dihedral": "min_dihedral_deg"}
 
 #: The native MeshOptions field (core/mesher.h for_each_mesh_option) of each core option of
-#: :func:`tetrahedralize`, as :func:`native_core_options` sets them.
+#: :func:`tetrahedralize` (:func:`native_core_options` sets them through this table).
 MESH_OPTION_OF = {"allow_boundary_steiner": "allow_boundary_steiner",
                   "steiner_effort": "steiner_effort", "bsp_seed": "seed"}
 

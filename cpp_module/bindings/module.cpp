@@ -205,6 +205,22 @@ py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, in
 
 }  // namespace
 
+// An options struct as a Python class, from its schema table (for_each calls f(name, member) for
+// every option): a default constructor, one attribute per option, and the class attribute
+// `names`, the options in the table's order.
+template <class Options, class ForEach>
+py::class_<Options> bind_options(py::module_& m, const char* name, const char* doc, ForEach for_each) {
+  py::class_<Options> c(m, name, doc);
+  c.def(py::init<>());
+  for_each([&](const char* option, auto member) { c.def_readwrite(option, member); });
+  c.def_property_readonly_static("names", [for_each](py::object) {
+    py::list names;
+    for_each([&](const char* option, auto) { names.append(option); });
+    return names;
+  });
+  return c;
+}
+
 PYBIND11_MODULE(_bsptet, m) {
   m.doc() = "FemBspTet C++ core (private; use FemBspTet.core)";
   m.attr("__version__") = FEMBSPTET_VERSION;
@@ -259,14 +275,8 @@ PYBIND11_MODULE(_bsptet, m) {
         .value("auto", MeshOptions::Seed::kAuto)
         .value("delaunay", MeshOptions::Seed::kDelaunay)
         .value("box", MeshOptions::Seed::kBox);
-    py::class_<MeshOptions> options(m, "MeshOptions", "Options of the exact core (mesher.h MeshOptions).");
-    options.def(py::init<>());
-    for_each_mesh_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
-    options.def_property_readonly_static("names", [](py::object) {
-      py::list names;
-      for_each_mesh_option([&](const char* name, auto) { names.append(name); });
-      return names;
-    });
+    auto options = bind_options<MeshOptions>(m, "MeshOptions", "Options of the exact core (mesher.h MeshOptions).",
+                                             [](auto&& f) { for_each_mesh_option(f); });
     options.def(py::pickle(
         [](const MeshOptions& o) {
           py::dict d;
@@ -428,16 +438,10 @@ PYBIND11_MODULE(_bsptet, m) {
                                                  "(refine_mesh.h SurfacePoints).")
         .value("exact", SurfacePoints::kExact)
         .value("rounded", SurfacePoints::kRounded);
-    py::class_<RefineOptions> options(m, "RefineOptions",
-                                      "Options of the quality stage (quality_refine.h RefineOptions): size is "
-                                      "FreeCAD's CharacteristicLengthMax (infinity: none).");
-    options.def(py::init<>());
-    for_each_refine_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
-    options.def_property_readonly_static("names", [](py::object) {
-      py::list names;
-      for_each_refine_option([&](const char* name, auto) { names.append(name); });
-      return names;
-    });
+    bind_options<RefineOptions>(m, "RefineOptions",
+                                "Options of the quality stage (quality_refine.h RefineOptions): size is "
+                                "FreeCAD's CharacteristicLengthMax (infinity: none).",
+                                [](auto&& f) { for_each_refine_option(f); });
   }
   m.def(
       "refine",
@@ -541,16 +545,10 @@ PYBIND11_MODULE(_bsptet, m) {
       "face, stats dict). Raises InputError (unreadable or unmeshable CAD, bad option) or MeshingError.";
   {
     // The options schema (fem/fem_mesh.h for_each_fem_option) and the statistics, as classes.
-    py::class_<fem::FemOptions> options(m, "FemOptions",
-                                        "Options of the FEM pipeline from CAD (fem/fem_mesh.h FemOptions); "
-                                        "FreeCAD's CharacteristicLengthMax is size.");
-    options.def(py::init<>());
-    fem::for_each_fem_option([&](const char* name, auto member) { options.def_readwrite(name, member); });
-    options.def_property_readonly_static("names", [](py::object) {
-      py::list names;
-      fem::for_each_fem_option([&](const char* name, auto) { names.append(name); });
-      return names;
-    });
+    bind_options<fem::FemOptions>(m, "FemOptions",
+                                  "Options of the FEM pipeline from CAD (fem/fem_mesh.h FemOptions); "
+                                  "FreeCAD's CharacteristicLengthMax is size.",
+                                  [](auto&& f) { fem::for_each_fem_option(f); });
     py::class_<fem::FemStats> stats(m, "FemStats", "Figures of a run of the FEM pipeline (fem/fem_mesh.h FemStats).");
     stats.def(py::init<>());
     fem::for_each_fem_stat([&](const char* name, auto member) { stats.def_readonly(name, member); });

@@ -274,6 +274,18 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
     }
     return mean / static_cast<double>(moved.size()) > mean_before + 1e-9;
   };
+  const Vec3 p = m_.point(v);
+  // All the way, else half way, towards y; marks v's neighbours when v moved.
+  const auto move_towards = [&](const Vec3& y) {
+    for (double f : {1.0, 0.5})
+      if (m_.relocate_point_if(v, {p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)}, accept)) {
+        for (Index t : ball)
+          for (Index w : m_.tet(t)) (*moved_near)[static_cast<std::size_t>(w)] = 1;
+        return true;
+      }
+    return false;
+  };
+  if (move_towards(x)) return true;
   // Then the centroid of its neighbours (Laplacian smoothing), where the ODT point is refused:
   // next to the surface the ODT point is pulled by the large circumspheres of the boundary
   // tets, while the centroid still evens the ball out (on the CAD corpus the median per-tet
@@ -283,16 +295,7 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
   for (Index t : ball)
     for (Index w : m_.tet(t))
       if (w != v) centroid.x += m_.point(w).x, centroid.y += m_.point(w).y, centroid.z += m_.point(w).z, ++k;
-  centroid = {centroid.x / k, centroid.y / k, centroid.z / k};
-  const Vec3 p = m_.point(v);
-  for (const Vec3& y : {x, centroid})
-    for (double f : {1.0, 0.5})
-      if (m_.relocate_point_if(v, {p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)}, accept)) {
-        for (Index t : ball)
-          for (Index w : m_.tet(t)) (*moved_near)[static_cast<std::size_t>(w)] = 1;
-        return true;
-      }
-  return false;
+  return move_towards({centroid.x / k, centroid.y / k, centroid.z / k});
 }
 
 // Moves interior points towards the centroid of their neighbours when it helps the worst tet.
