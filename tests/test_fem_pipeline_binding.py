@@ -6,6 +6,7 @@ moved and rotated part with a hole.
 """
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -25,13 +26,15 @@ def boundary_faces(tets):
     return faces[counts[inverse.ravel()] == 1]
 
 
-def check(points, tets, tet_solid, triangles, triangle_face, stats, order, solids, faces):
+def check(points, tets, tet_solid, triangles, triangle_face, stats, solid_names, face_names,
+          order, solids, faces):
     npt, npf = (10, 6) if order == 2 else (4, 3)
     assert points.shape[1] == 3 and tets.shape[1] == npt and triangles.shape[1] == npf
     assert tet_solid.shape == (tets.shape[0],) and triangle_face.shape == (triangles.shape[0],)
     assert set(tet_solid.tolist()) == set(range(solids))
     assert set(triangle_face.tolist()) == set(range(faces))
     assert stats["tets"] == tets.shape[0] and stats["nodes"] == points.shape[0]
+    assert len(solid_names) == solids and len(face_names) == faces
     # Exactly valid against its own boundary: positive, conforming, closed, one mid-node per edge.
     report = _bsptet.check_mesh(points, boundary_faces(tets), points, tets, compute_quality=False)
     assert report["valid"], report["messages"]
@@ -81,7 +84,15 @@ def test_mesh_cad_file_red_cube_blue_cylinder(order):
     out = _bsptet.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"),
                                 options=options(order=order))
     check(*out, order=order, solids=2, faces=9)
-    stats = out[-1]
+    stats, solid_names, face_names = out[5:]
+    # The STEP file names its solids (MANIFOLD_SOLID_BREP), not its faces: FreeCAD's names then.
+    # Each name is on its own solid: the 10 mm cube's tets fill 1000 mm^3.
+    assert sorted(solid_names) == ["blue_cylinder", "red_cube"]
+    assert face_names == [f"Face{k}" for k in range(1, 10)]
+    points, tets, tet_solid = out[:3]
+    a, b, c, d = (points[tets[:, k]] for k in range(4))
+    volume = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+    assert volume[tet_solid == solid_names.index("red_cube")].sum() == pytest.approx(1000, rel=1e-9)
     assert stats["min_dihedral_deg"] > 0
     assert 0 <= stats["tets_below_10_deg"] <= 1
     for key in ("seconds_surface", "seconds_core", "seconds_refine", "seconds_merge", "seconds_total"):
@@ -119,7 +130,8 @@ def test_mesh_cad_brep_nodes_found_by_face(order):
     shape.Placement = freecad.Placement(freecad.Vector(3.5, -7.25, 11.0),
                                         freecad.Rotation(freecad.Vector(1, 2, 3), 37.0))
     out = _bsptet.mesh_cad_brep(shape.exportBrepToString(), options=options(order=order))
-    points, tets, _, triangles, triangle_face, _ = out
+    points, tets, _, triangles, triangle_face = out[:5]
+    assert out[7] == [f"Face{k}" for k in range(1, len(shape.Faces) + 1)]  # a BREP has no names
     check(*out, order=order, solids=1, faces=len(shape.Faces))
     fem = Fem.FemMesh()
     for i, p in enumerate(points, start=1):
@@ -128,3 +140,27 @@ def test_mesh_cad_brep_nodes_found_by_face(order):
         wanted = set((triangles[triangle_face == k].ravel() + 1).tolist())
         found = set(fem.getNodesByFace(face))
         assert wanted <= found, "Face%d: %d of its nodes not found" % (k + 1, len(wanted - found))
+
+
+def test_step_names_become_unique_set_names(tmp_path):
+    """A STEP file's names of solids and faces name the sets: cleaned to letters, digits, '-' and
+    '_', unique up to case (a shared name gets FreeCAD's name appended), FreeCAD's names where the
+    file gives none or only "NONE" or no letter."""
+    with open(os.path.join(DATA, "red_cube_blue_cylinder.step")) as f:
+        text = f.read()
+    text = text.replace("'red_cube'", "'Blue_Cylinder'")  # the two solids' names now clash
+    faces = iter(["Top face!", "NONE", "#12", "Face1", "", "", "", "", ""])
+    while "ADVANCED_FACE( ''" in text:
+        text = text.replace("ADVANCED_FACE( ''", f"ADVANCED_FACE( '{next(faces)}@'", 1)
+    text = text.replace("@'", "'")
+    path = tmp_path / "renamed.step"
+    path.write_text(text)
+    _, _, _, _, tri_face, _, solid_names, face_names = _bsptet.mesh_cad_file(
+        str(path), dimension=2, options=options(order=1))
+    assert solid_names == ["blue_cylinder_Solid1", "Blue_Cylinder_Solid2"]  # equal up to case
+    assert len({n.upper() for n in solid_names + face_names}) == len(solid_names) + len(face_names)
+    # "NONE", "#12" and "" are no names; a face named "Face1" that is not Face1 gets its own name
+    # appended.
+    assert face_names.count("Top_face") == 1
+    assert all(re.fullmatch(r"Top_face|Face\d+|Face1_Face\d+", n) for n in face_names), face_names
+    assert set(tri_face.tolist()) == set(range(9))

@@ -2,7 +2,8 @@
 """Named sets per CAD face and per solid, in every format `fembsptet mesh` writes, read back by
 readers that are not ours (meshio, the gmsh binary, FreeCAD's Fem.read) and by ours.
 
-The part has two solids (a cube and a cylinder) and nine CAD faces; the CLI's mesh is compared
+The part has two solids (a cube and a cylinder, named "red_cube" and "blue_cylinder" by the STEP
+file) and nine CAD faces (unnamed: FreeCAD's Face1..Face9); the CLI's mesh is compared
 with the FEM path's own groups (the meshing is deterministic: same nodes, same numbering)."""
 
 import os
@@ -19,6 +20,7 @@ from FemBspTet.kernel.freecad_env import freecad_available
 from FemBspTet.io.volume_io import read_tet_mesh
 
 PART = os.path.join(os.path.dirname(__file__), "data", "cad", "red_cube_blue_cylinder.step")
+SOLIDS = ["blue_cylinder", "red_cube"]  # Solid1, Solid2 in FreeCAD's order
 FORMATS = ["m.vtu", "m.msh", "m.inp", "m.mesh", "m.node"]
 
 
@@ -45,7 +47,7 @@ def face_nodes(groups, tag):
 def test_the_part_has_two_solids_and_nine_faces(written):
     _, result = written
     groups = result.groups
-    assert groups.solid_names == ["Solid1", "Solid2"]
+    assert groups.solid_names == SOLIDS
     assert set(np.unique(groups.tet_solid).tolist()) == {0, 1}
     assert groups.face_names == [f"Face{i}" for i in range(1, 10)]
     assert set(np.unique(groups.face_tags).tolist()) == set(range(9))
@@ -74,8 +76,8 @@ def test_msh_physical_names_through_meshio(written):
     groups = result.groups
     m = meshio.read(out / "m.msh")
     names = {k: (int(v[0]), int(v[1])) for k, v in m.field_data.items()}
-    assert names == {**{f"Face{i}": (i, 2) for i in range(1, 10)}, "Solid1": (1, 3),
-                     "Solid2": (2, 3)}
+    assert names == {**{f"Face{i}": (i, 2) for i in range(1, 10)}, SOLIDS[0]: (1, 3),
+                     SOLIDS[1]: (2, 3)}
     by_type = {c.type: k for k, c in enumerate(m.cells)}
     tet_tags = m.cell_data["gmsh:physical"][by_type["tetra10"]]
     assert np.array_equal(tet_tags, groups.tet_solid + 1)
@@ -94,7 +96,7 @@ def test_msh_physical_groups_through_gmsh(written, tmp_path):
     block = text[text.index("$PhysicalNames"):text.index("$EndPhysicalNames")]
     for i in range(1, 10):
         assert f'2 {i} "Face{i}"' in block
-    assert '3 1 "Solid1"' in block and '3 2 "Solid2"' in block
+    assert f'3 1 "{SOLIDS[0]}"' in block and f'3 2 "{SOLIDS[1]}"' in block
     back = read_tet_mesh(tmp_path / "g.msh")
     assert sorted(np.bincount(back.extra["region"]).tolist()) == \
         sorted([0] + np.bincount(result.groups.tet_solid).tolist())
@@ -109,7 +111,7 @@ def test_inp_sets_through_meshio(written):
     for tag in range(9):
         assert set(m.point_sets[f"Face{tag + 1}"].tolist()) == face_nodes(groups, tag)
     for solid in (0, 1):
-        ids = np.concatenate([c for c in m.cell_sets[f"Solid{solid + 1}"] if c is not None])
+        ids = np.concatenate([c for c in m.cell_sets[SOLIDS[solid]] if c is not None])
         assert set(ids.tolist()) == set(np.flatnonzero(groups.tet_solid == solid).tolist())
     text = (out / "m.inp").read_text()
     assert text.count("*SURFACE, NAME=Face") == 9
@@ -150,7 +152,7 @@ def test_freecad_reads_the_groups(written, name):
         faces = fem.getGroupElements(found[(f"Face{tag + 1}", "Face")])
         assert len(faces) == int((groups.face_tags == tag).sum())
     for solid in (0, 1):
-        volumes = fem.getGroupElements(found[(f"Solid{solid + 1}", "Volume")])
+        volumes = fem.getGroupElements(found[(SOLIDS[solid], "Volume")])
         assert len(volumes) == int((groups.tet_solid == solid).sum())
 
 
@@ -164,7 +166,7 @@ def test_msh41_groups_through_meshio_and_gmsh(tmp_path):
     groups = result.groups
     m = meshio.read(out)
     names = {k: (int(v[0]), int(v[1])) for k, v in m.field_data.items()}
-    assert names["Face9"] == (9, 2) and names["Solid2"] == (2, 3)
+    assert names["Face9"] == (9, 2) and names[SOLIDS[1]] == (2, 3)
     tets = np.concatenate([c.data for c in m.cells if c.type == "tetra10"])
     assert len(tets) == len(result.mesh.tets)
     subprocess.run(["gmsh", str(out), "-0", "-format", "msh22", "-o", "g.msh"], cwd=tmp_path,

@@ -137,7 +137,7 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
                           size_by_face=size_by_face)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                               source=""), "FEM mesh"):
-        points, tets, tet_solid, tri, tri_face, stats = native_call(
+        points, tets, tet_solid, tri, tri_face, stats, solid_names, face_names = native_call(
             options=options,
             progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
             cancel=cancel)
@@ -159,7 +159,7 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
     touching = _touching_solids(mesh.points[:corners], mesh.tets[:, :4], tet_solid)
     if touching:
         stats["unconnected_touching_solids"] = touching
-        pairs = ", ".join(f"Solid{a}-Solid{b}" for a, b in touching[:6])
+        pairs = ", ".join(f"{solid_names[a]}-{solid_names[b]}" for a, b in touching[:6])
         more = f" and {len(touching) - 6} more" if len(touching) > 6 else ""
         stats.setdefault("notes", []).append(
             f"{len(touching)} pairs of solids touch without sharing a CAD face ({pairs}{more}): "
@@ -172,11 +172,8 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
                  boundary_steiner_points=0, steiner_points=int(stats["core_steiner_points"]))
     midnodes = tri[on_boundary, 3:6] if tri.shape[1] == 6 else np.zeros((0, 3), dtype=np.int64)
     tri_face = np.asarray(tri_face, dtype=np.int64)
-    faces = max(int(stats["faces"]), int(tri_face.max()) + 1 if len(tri_face) else 0)
-    solids = max(int(stats["solids"]), int(tet_solid.max()) + 1 if len(tet_solid) else 0)
-    groups = MeshGroups(face_triangles=tri, face_tags=tri_face,
-                        face_names=MeshGroups.default_names("Face", faces),
-                        tet_solid=tet_solid, solid_names=MeshGroups.default_names("Solid", solids))
+    groups = MeshGroups(face_triangles=tri, face_tags=tri_face, face_names=list(face_names),
+                        tet_solid=tet_solid, solid_names=list(solid_names))
     return CadMeshResult(mesh=mesh, tet_solid=np.asarray(tet_solid), boundary=boundary,
                          boundary_midnodes=midnodes, stats=stats, groups=groups)
 
@@ -222,7 +219,7 @@ def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, ca
                           size_by_face=size_by_face)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                              source=""), "FEM surface mesh"):
-        points, _tets, _solid, tri, tri_face, stats = native().mesh_cad_brep(
+        points, _tets, _solid, tri, tri_face, stats, _solid_names, face_names = native().mesh_cad_brep(
             brep, dimension=2, options=options,
             progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
             cancel=cancel)
@@ -234,9 +231,7 @@ def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, ca
     stats.update(triangles=int(len(tri)), points=int(len(points)),
                  min_triangle_angle_deg=float(angles.min()) if len(angles) else 0.0,
                  median_triangle_min_angle_deg=float(np.median(angles)) if len(angles) else 0.0)
-    faces = max(int(stats["faces"]), int(tri_face.max()) + 1 if len(tri_face) else 0)
-    groups = MeshGroups(face_triangles=tri, face_tags=tri_face,
-                        face_names=MeshGroups.default_names("Face", faces))
+    groups = MeshGroups(face_triangles=tri, face_tags=tri_face, face_names=list(face_names))
     return CadFacesResult(points=points, triangles=tri, face_tags=tri_face, stats=stats,
                           groups=groups)
 

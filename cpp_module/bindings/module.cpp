@@ -175,7 +175,7 @@ py::dict fem_stats_dict(const fem::FemStats& st) {
 
 // The FEM pipeline (fem/fem_mesh.h, or fem/fem_faces.h in 2D) on a model read by `read`.
 // Returns (points (n, 3), tets (k, 4 or 10; none in 2D), tet_solid (k,), triangles (f, 3 or 6),
-// triangle_face (f,), stats dict).
+// triangle_face (f,), stats dict, solid names, face names).
 py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension,
                    fem::FemOptions o, const py::object& progress, const py::object& cancel) {
   if (dimension != 2 && dimension != 3)
@@ -200,7 +200,8 @@ py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, in
   py::dict d = fem_stats_dict(st);
   d["order"] = o.order;
   d["dimension"] = dimension;
-  return py::make_tuple(points_array(fm.mesh), tets_array(fm.mesh), tet_solid, tri, tri_face, d);
+  return py::make_tuple(points_array(fm.mesh), tets_array(fm.mesh), tet_solid, tri, tri_face, d,
+                        py::cast(fm.solid_names), py::cast(fm.face_names));
 }
 
 }  // namespace

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <map>
+#include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include <BRepBndLib.hxx>
 #include <BRepTools.hxx>
@@ -13,8 +16,14 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
 #include <STEPControl_Reader.hxx>
+#include <StepRepr_RepresentationItem.hxx>
 #include <Standard_Failure.hxx>
+#include <TCollection_HAsciiString.hxx>
 #include <TopExp.hxx>
+#include <TransferBRep.hxx>
+#include <Transfer_TransientProcess.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Vertex.hxx>
 
@@ -37,11 +46,73 @@ std::string lower_extension(const std::string& path) {
   throw InputError(ErrorCode::kBadArgument, kStage, -1, source + ": " + what);
 }
 
-TopoDS_Shape read_step(const std::string& path) {
+// The names a STEP file gives the entities its shapes were made from, by TShape (so every
+// placement of an instanced part gets its part's names).
+using ShapeNames = std::unordered_map<const TopoDS_TShape*, std::string>;
+
+TopoDS_Shape read_step(const std::string& path, ShapeNames& names) {
   STEPControl_Reader reader;
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) fail(path, "not a readable STEP file");
   reader.TransferRoots();
+  const Handle(Transfer_TransientProcess) process = reader.WS()->TransferReader()->TransientProcess();
+  for (int i = 1; !process.IsNull() && i <= process->NbMapped(); ++i) {
+    const auto item = Handle(StepRepr_RepresentationItem)::DownCast(process->Mapped(i));
+    if (item.IsNull() || item->Name().IsNull() || item->Name()->Length() == 0) continue;
+    const TopoDS_Shape made = TransferBRep::ShapeResult(process, item);
+    if (!made.IsNull()) names.emplace(made.TShape().get(), item->Name()->ToCString());
+  }
   return reader.OneShape();
+}
+
+// A CAD name as a set name (see cad_model.h), "" when it is not one.
+std::string set_name(const std::string& cad_name) {
+  std::string name;
+  for (const unsigned char c : cad_name) {
+    const bool keep = std::isalnum(c) || c == '-' || c == '_';
+    if (keep || (!name.empty() && name.back() != '_')) name += keep ? static_cast<char>(c) : '_';
+  }
+  if (name.size() > 48) name.resize(48);  // set names: CalculiX and MED allow 80 characters
+  while (!name.empty() && name.back() == '_') name.pop_back();
+  std::string upper = name;
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+  const bool letter = std::any_of(name.begin(), name.end(), [](unsigned char c) { return std::isalpha(c); });
+  return letter && upper != "NONE" ? name : "";
+}
+
+std::string upper_case(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::toupper(c); });
+  return s;
+}
+
+// Fills model.solid_names and face_names (see cad_model.h) from `names` (may be empty).
+void name_entities(CadModel& model, const ShapeNames& names) {
+  struct Entity {
+    std::vector<std::string>* out;
+    std::string cad, fallback;
+  };
+  std::vector<Entity> entities;
+  model.solid_names.resize(static_cast<std::size_t>(model.num_solids()));
+  model.face_names.resize(static_cast<std::size_t>(model.num_faces()));
+  const auto add = [&](const TopTools_IndexedMapOfShape& shapes, std::vector<std::string>& out, const char* prefix) {
+    for (int k = 1; k <= shapes.Extent(); ++k) {
+      const auto it = names.find(shapes(k).TShape().get());
+      entities.push_back({&out, it == names.end() ? "" : set_name(it->second), prefix + std::to_string(k)});
+    }
+  };
+  add(model.solids, model.solid_names, "Solid");
+  add(model.faces, model.face_names, "Face");
+  std::map<std::string, int> uses;  // upper-case name -> entities that would take it
+  for (const Entity& e : entities) ++uses[upper_case(e.cad.empty() ? e.fallback : e.cad)];
+  std::set<std::string> taken;
+  std::size_t index[2] = {0, 0};
+  for (const Entity& e : entities) {
+    std::string name = e.cad.empty() ? e.fallback : e.cad;
+    if (!e.cad.empty() && uses[upper_case(name)] > 1) name += "_" + e.fallback;
+    if (!taken.insert(upper_case(name)).second) name = e.fallback;  // taken by a default name
+    taken.insert(upper_case(name));
+    const int which = e.out == &model.solid_names ? 0 : 1;
+    (*e.out)[index[which]++] = name;
+  }
 }
 
 TopoDS_Shape read_iges(const std::string& path) {
@@ -85,6 +156,7 @@ CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source, Ca
   TopExp::MapShapes(shape, TopAbs_FACE, model.faces);
   TopExp::MapShapes(shape, TopAbs_EDGE, model.edges);
   TopExp::MapShapes(shape, TopAbs_VERTEX, model.vertices);
+  name_entities(model, ShapeNames());
   if (content == CadContent::kFaces) {
     if (model.faces.Extent() == 0) fail(source, "holds no face: a surface mesh needs a Face or a Shell");
     return model;
@@ -114,9 +186,10 @@ CadModel make_cad_model(const TopoDS_Shape& shape, const std::string& source, Ca
 CadModel read_cad_file(const std::string& path, CadContent content) {
   const std::string ext = lower_extension(path);
   TopoDS_Shape shape;
+  ShapeNames names;
   try {
     if (ext == "step" || ext == "stp") {
-      shape = read_step(path);
+      shape = read_step(path, names);
     } else if (ext == "iges" || ext == "igs") {
       shape = read_iges(path);
     } else if (ext == "brep" || ext == "brp") {
@@ -127,7 +200,9 @@ CadModel read_cad_file(const std::string& path, CadContent content) {
   } catch (const Standard_Failure& e) {
     fail(path, std::string("OpenCASCADE could not read it: ") + (e.GetMessageString() ? e.GetMessageString() : "?"));
   }
-  return make_cad_model(shape, path, content);
+  CadModel model = make_cad_model(shape, path, content);
+  if (!names.empty()) name_entities(model, names);
+  return model;
 }
 
 CadModel read_brep_string(const std::string& brep, const std::string& source, CadContent content) {

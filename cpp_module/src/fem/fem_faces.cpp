@@ -69,6 +69,8 @@ FemMesh mesh_cad_faces(const cad::CadModel& model, const FemOptions& options, Fe
   st.surface_nodes = sst.nodes;
 
   FemMesh out;
+  out.solid_names = model.solid_names;
+  out.face_names = model.face_names;
   out.mesh.xyz = surface.xyz;
   out.tri_face = surface.face_tag;
   const Index n_tri = static_cast<Index>(surface.face_tag.size());

@@ -129,6 +129,8 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   std::map<std::array<Index, 2>, Index> mid_of_edge;   // sorted corner pair -> mid-node
   std::vector<Index> tets;                             // merged ids; mid-nodes as -(1 + mid index)
   FemMesh out;
+  out.solid_names = model.solid_names;
+  out.face_names = model.face_names;
   // Triangles, deduplicated by their sorted corners (a shared face's triangles come twice).
   std::set<std::array<Index, 3>> seen_triangles;
   std::vector<std::array<Index, 3>> tri_corners;

@@ -9,6 +9,14 @@
 // Face2, ...) uses. Indices here are 0-based: face k is FreeCAD's "Face<k+1>" and the surface
 // tag of its triangles. A face shared by two solids of a CompSolid has one index.
 //
+// Names, for the outputs' sets: solid k is "Solid<k+1>" and face k "Face<k+1>" (FreeCAD's
+// names), unless a STEP file names the entity (MANIFOLD_SOLID_BREP, ADVANCED_FACE, ...: the
+// name of the representation item the shape was made from). A STEP name is kept when it holds a
+// letter and is not "NONE"; characters other than letters, digits, '-' and '_' become '_', and
+// it is cut at 48 characters (CalculiX and MED allow 80 in a set name); a name
+// that several entities share, or that equals another name up to case (solvers such as CalculiX
+// ignore case), gets the default name appended ("nut_Solid3"). Every name is unique up to case.
+//
 // This layer is the only one that links OpenCASCADE; nothing below it (mesh, core, refine) does.
 #pragma once
 
@@ -25,6 +33,8 @@ struct CadModel {
   TopoDS_Shape shape;
   TopTools_IndexedMapOfShape solids, faces, edges, vertices;  ///< 1-based maps (OCC's own)
   std::string source;  ///< the file name, or "BREP string": named in messages
+  /// 0-based, see "Names" above; always num_solids() and num_faces() long.
+  std::vector<std::string> solid_names, face_names;
 
   int num_solids() const { return solids.Extent(); }
   int num_faces() const { return faces.Extent(); }

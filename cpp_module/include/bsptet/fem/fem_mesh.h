@@ -129,6 +129,8 @@ struct FemMesh {
   int nodes_per_triangle = 3;
   /// #F: the CAD face (0-based: FreeCAD's Face<k+1>) of each triangle.
   std::vector<std::int32_t> tri_face;
+  /// The model's names of its solids and faces, for the outputs' sets (cad_model.h).
+  std::vector<std::string> solid_names, face_names;
 
   Index num_triangles() const { return static_cast<Index>(tri_face.size()); }
 };
