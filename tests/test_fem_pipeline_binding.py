@@ -57,15 +57,18 @@ def test_the_options_schema_is_one_table():
 
     names = list(_bsptet.FemOptions.names)
     assert names == ["size", "min_size", "size_by_face", "points_per_circle", "grading", "order",
-                     "optimize_rounds", "face_rounds"]
+                     "optimize_rounds", "face_rounds", "workers"]
     o = _bsptet.FemOptions()
-    assert (o.size, o.min_size, o.order, o.grading, o.points_per_circle) == (0, 0, 2, 0.3, 12)
+    assert (o.size, o.min_size, o.order, o.grading, o.points_per_circle, o.workers) == \
+        (0, 0, 2, 0.3, 12, 0)
     with pytest.raises(AttributeError):
         o.no_such_option = 1
     # the Python builder refuses names outside the schema
     with pytest.raises(ValueError, match="unknown FEM option"):
         fem_options("x", sizee=1.0)
     assert fem_options("x", size=2.0, order=1).order == 1
+    with pytest.raises(ValueError, match="workers"):
+        fem_options("x", workers=-2)
     # the CLI's FEM flags and the FreeCAD object's parameters name schema options
     assert set(FEM_OPTION_OF_FLAG.values()) <= set(names)
     fields = {f for f in MeshParameters.__dataclass_fields__}
@@ -164,3 +167,18 @@ def test_step_names_become_unique_set_names(tmp_path):
     assert face_names.count("Top_face") == 1
     assert all(re.fullmatch(r"Top_face|Face\d+|Face1_Face\d+", n) for n in face_names), face_names
     assert set(tri_face.tolist()) == set(range(9))
+
+
+def test_solids_meshed_at_the_same_time_give_the_same_mesh():
+    """FemOptions.workers solids at a time, each on its own thread: the arrays are identical for
+    1 and 2 workers and for every core (0), and the mesh is valid."""
+    path = os.path.join(DATA, "red_cube_blue_cylinder.step")
+    runs = [_bsptet.mesh_cad_file(path, options=options(order=2, workers=w)) for w in (1, 2, 0)]
+    check(*runs[1], order=2, solids=2, faces=9)
+    for other in runs[1:]:
+        for a, b in zip(runs[0][:5], other[:5]):
+            assert np.array_equal(a, b)
+        assert other[6:] == runs[0][6:]
+        assert other[5]["tets"] == runs[0][5]["tets"]
+    with pytest.raises(ValueError, match="workers"):
+        _bsptet.mesh_cad_file(path, options=options(workers=-1))

@@ -58,7 +58,8 @@ from ..fem.pieces import default_workers, tetrahedralize_in_pieces
 # Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
 #: The FEM path's options (``FemOptions``, the schema of ``fem/fem_mesh.h``) that ``mesh`` flags
 #: set for CAD input: argparse destination -> option (None: the option's default).
-FEM_OPTION_OF_FLAG = {"size": "size", "min_size": "min_size", "order": "order"}
+FEM_OPTION_OF_FLAG = {"size": "size", "min_size": "min_size", "order": "order",
+                      "workers": "workers"}
 
 STATS_KEYS = (
     "input_points",
@@ -204,7 +205,6 @@ def _mesh_cad_fem(args, progress):
                                              args.allow_boundary_steiner or None),
                                             ("--out-of-core", getattr(args, "out_of_core", None)
                                              or None),
-                                            ("--workers", args.workers),
                                             ("--scheduler", args.scheduler))
                    if value is not None]
     if unsupported:
@@ -657,9 +657,11 @@ def build_parser():
                         "their points become interior nodes); the core's mesh only: no --size, "
                         "quality or --order 2")
     m.add_argument("--workers", metavar="N", type=int, default=None,
-                   help="mesh the solid in about N pieces, N at a time (default: every core for a "
-                        "surface of at least 200,000 triangles meshed by the core alone, else 1); "
-                        "the mesh depends on N, not on where the pieces ran")
+                   help="a CAD file: mesh N solids at a time, one thread each (default: every "
+                        "core; the mesh is the same for any N). A triangle surface: mesh it in "
+                        "about N pieces, N at a time (default: every core for a surface of at "
+                        "least 200,000 triangles meshed by the core alone, else 1); the mesh "
+                        "depends on N, not on where the pieces ran")
     m.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="mesh the pieces on the workers of this Dask cluster (tcp://HOST:8786; "
                         "python3-distributed; every worker must import FemBspTet); --workers then "

@@ -105,7 +105,7 @@ def _touching_solids(points, corner_tets, tet_solid):
 def fem_options(source="", **values):
     """The native FemOptions (the options schema, ``fem/fem_mesh.h`` for_each_fem_option) with
     ``values`` set: ``size``, ``min_size``, ``order``, ``size_by_face``, ``points_per_circle``,
-    ``grading``, ``optimize_rounds``, ``face_rounds`` (None: the default). Raises InputError for
+    ``grading``, ``optimize_rounds``, ``face_rounds``, ``workers`` (None: the default). Raises InputError for
     an unknown name or a value out of range, naming ``source``."""
     options = native().FemOptions()
     unknown = sorted(set(values) - set(native().FemOptions.names))
@@ -115,6 +115,10 @@ def fem_options(source="", **values):
     order = values.get("order")
     if order is not None and order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}", where=source)
+    workers = values.get("workers")
+    if workers is not None and (int(workers) != workers or workers < 0):
+        raise InputError(f"workers must be a whole number >= 0 (0: every core), got {workers}",
+                         where=source)
     for name in ("size", "min_size"):
         value = values.get(name)
         if value is not None and (not np.isfinite(value) or value < 0):
@@ -132,9 +136,9 @@ def fem_options(source="", **values):
     return options
 
 
-def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face):
+def _run(native_call, source, size, min_size, order, progress, cancel, size_by_face, workers):
     options = fem_options(source, size=size, min_size=min_size, order=order,
-                          size_by_face=size_by_face)
+                          size_by_face=size_by_face, workers=workers)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                               source=""), "FEM mesh"):
         points, tets, tet_solid, tri, tri_face, stats, solid_names, face_names = native_call(
@@ -179,21 +183,23 @@ def _run(native_call, source, size, min_size, order, progress, cancel, size_by_f
 
 
 def mesh_cad_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
-                  size_by_face=None):
+                  size_by_face=None, workers=None):
     """Meshes every solid of a STEP, BREP or IGES file (see the module doc). ``progress(stage,
-    fraction)`` and ``cancel() -> bool`` are optional. Raises InputError (unreadable or
-    unmeshable part, naming the CAD face or solid; bad option) or MeshingError."""
+    fraction)`` and ``cancel() -> bool`` are optional. ``workers``: solids meshed at the same
+    time, one thread each (None or 0: the machine's cores); the mesh is the same for any value.
+    Raises InputError (unreadable or unmeshable part, naming the CAD face or solid; bad option)
+    or MeshingError."""
 
     return _run(lambda **kw: native().mesh_cad_file(str(path), **kw), str(path), size, min_size,
-                order, progress, cancel, size_by_face)
+                order, progress, cancel, size_by_face, workers)
 
 
 def mesh_cad_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
-                  size_by_face=None, source="BREP string"):
+                  size_by_face=None, source="BREP string", workers=None):
     """The same for a shape in OpenCASCADE's BREP text (FreeCAD's ``Shape.exportBrepToString()``)."""
 
     return _run(lambda **kw: native().mesh_cad_brep(brep, **kw), source, size, min_size, order,
-                progress, cancel, size_by_face)
+                progress, cancel, size_by_face, workers)
 
 
 @dataclasses.dataclass
@@ -210,13 +216,13 @@ class CadFacesResult:
 
 
 def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
-                        size_by_face=None, source="BREP string"):
+                        size_by_face=None, source="BREP string", workers=None):
     """Every CAD face of a shape in BREP text (a Face, a Shell, or the faces of solids) as
     triangles at the size field, tria6 mid-nodes on the CAD (``cpp_module/include/bsptet/fem/
-    fem_faces.h``): shell and plane analyses. Raises InputError (no face, bad option) or
-    MeshingError."""
+    fem_faces.h``): shell and plane analyses, on one thread (``workers`` is accepted for the
+    3D path's sake and not used). Raises InputError (no face, bad option) or MeshingError."""
     options = fem_options(source, size=size, min_size=min_size, order=order,
-                          size_by_face=size_by_face)
+                          size_by_face=size_by_face, workers=workers)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                              source=""), "FEM surface mesh"):
         points, _tets, _solid, tri, tri_face, stats, _solid_names, face_names = native().mesh_cad_brep(

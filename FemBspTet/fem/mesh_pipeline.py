@@ -48,10 +48,12 @@ PROPERTY_OF = {
     "face_groups": "FaceGroups",
     "compare_peers": "CompareWithPeers",
     "dimension": "ElementDimension",
+    "workers": "Workers",
 }
 
 #: The native FemOptions (the schema of ``fem/fem_mesh.h``) each MeshParameters field sets.
-FEM_OPTION_OF_PARAMETER = {"max_size": "size", "min_size": "min_size", "order": "order"}
+FEM_OPTION_OF_PARAMETER = {"max_size": "size", "min_size": "min_size", "order": "order",
+                           "workers": "workers"}
 
 #: Parameters of the former tessellation pipeline, by FreeCAD property name: the FEM path meshes
 #: the CAD surface itself, so none of them has a meaning any more. Named in the message that
@@ -104,6 +106,8 @@ class MeshParameters:
                     (on the CAD part, where installed) and report their counts, angles, times.
     dimension:      3: the solids as tets; 2: every CAD face as triangles (tria3 / tria6, shell
                     and plane analyses); 0: from the shape (3 if it holds a solid, else 2).
+    workers:        solids meshed at the same time, one thread each; 0 = every core (the mesh
+                    is the same for any value).
     """
 
     max_size: float = 0.0
@@ -112,6 +116,7 @@ class MeshParameters:
     face_groups: bool = True
     compare_peers: bool = False
     dimension: int = 0
+    workers: int = 0
 
     def validate(self):
         """Raise InputError naming the property if a value is out of range; return self."""
@@ -123,6 +128,9 @@ class MeshParameters:
         if self.dimension not in (0, 2, 3):
             raise InputError("%s must be From Shape, 2D or 3D (dimension 0, 2 or 3), got %r"
                              % (PROPERTY_OF["dimension"], self.dimension))
+        if not (isinstance(self.workers, int) and self.workers >= 0):
+            raise InputError("%s must be a whole number >= 0 (0 = every core), got %r"
+                             % (PROPERTY_OF["workers"], self.workers))
         if self.order not in (1, 2):
             raise InputError("%s must be 1st or 2nd (order 1 or 2), got %r"
                              % (PROPERTY_OF["order"], self.order))

@@ -75,6 +75,9 @@ PARAMETER_PROPERTIES = (
      "Also mesh the part at the same size with TetGen (tetgen -pq with the matching volume "
      "bound, on this mesh's surface), Gmsh and Netgen (on the CAD part, where installed) and "
      "show their counts, angles and times", True),
+    ("App::PropertyInteger", "Workers", PARAMS_GROUP,
+     "Solids meshed at the same time, one processor core each (0 = every core); the mesh is "
+     "the same for any value", 0),
 )
 
 #: (type, name, tooltip) of every read-only result property.

@@ -36,6 +36,7 @@ def parameters_from_object(obj):
         face_groups=bool(obj.FaceGroups),
         compare_peers=bool(obj.CompareWithPeers),
         dimension=dimension_of(shape_of(obj), DIMENSION_OF[obj.ElementDimension]),
+        workers=int(getattr(obj, "Workers", 0)),
     ).validate()
 
 

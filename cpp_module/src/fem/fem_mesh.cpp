@@ -6,9 +6,13 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "bsptet/cad/cad_projection.h"
 #include "bsptet/cad/cad_surface.h"
@@ -40,6 +44,150 @@ constexpr int kTetEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
 Vec3 midpoint(const Vec3& a, const Vec3& b) { return {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)}; }
 bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
+// The faces of solid s that bound another solid too: their surface stays as meshed.
+std::vector<std::int32_t> fixed_tags_of(const std::vector<std::vector<std::int32_t>>& faces_of_solid,
+                                        const std::vector<int>& solids_of_face, int s) {
+  std::vector<std::int32_t> fixed;
+  for (std::int32_t f : faces_of_solid[static_cast<std::size_t>(s)])
+    if (solids_of_face[static_cast<std::size_t>(f)] > 1) fixed.push_back(f);
+  return fixed;
+}
+
+// One solid's core and refinement (stages 2 and 3), before the merge.
+struct SolidMesh {
+  std::vector<Index> node_of;  // the solid surface's nodes -> CAD surface nodes
+  SurfaceMesh solid;           // the solid's closed CAD surface
+  TetMesh refined;             // its refined mesh (the surface nodes first, in order)
+  SurfaceMesh boundary;        // its boundary triangles with their CAD face tags
+  MeshStats mst;
+  RefineStats rst;
+  cad::ProjectionStats projection;
+  double seconds_core = 0, seconds_refine = 0;
+};
+
+using Report = std::function<void(const std::string&, double)>;
+
+// Stages 2 and 3 for solid s. `cancelled` as MeshOptions::cancelled; `report(stage, f)` with f
+// the fraction of this solid's work done.
+SolidMesh mesh_solid(const cad::CadModel& model, const cad::CadSurface& surface, const cad::CadSurfaceStats& sst,
+                     const std::vector<std::int32_t>& fixed_tags, const FemOptions& options, int s,
+                     const std::function<bool()>& cancelled, const Report& report) {
+  SolidMesh out;
+  const std::string name = "Solid" + std::to_string(s + 1);
+  out.solid = surface.solid_surface(s, &out.node_of);
+  // Its own projector: CadProjector is not thread-safe, and its answers then depend on this
+  // solid's calls only.
+  std::shared_ptr<cad::CadProjector> projector;
+  const ProjectionHook hook = cad::make_projection_hook(model, &projector);
+
+  MeshOptions mo;
+  mo.progress = [&](const std::string& stage, double f) { report(name + ": " + stage, 0.3 * f); };
+  mo.cancelled = cancelled;
+  auto t = Clock::now();
+  try {
+    out.refined = check_and_tetrahedralize(out.solid, SurfaceCheckOptions{}, mo, &out.mst);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::kCancelled) throw;
+    rethrow_for_solid(e, model, s);
+  }
+  out.seconds_core = seconds_since(t);
+
+  RefineOptions ro;
+  ro.size = sst.size;
+  ro.min_size = sst.min_size;
+  for (const auto& [face, size] : options.size_by_face) ro.size_by_tag[face] = size;
+  ro.size_from_surface = true;
+  ro.grading = options.grading;
+  ro.order = options.order;
+  ro.optimize_rounds = options.optimize_rounds;
+  ro.projection = hook;
+  ro.fixed_tags = fixed_tags;
+  ro.progress = [&](const std::string& stage, double f) { report(name + ": " + stage, 0.3 + 0.7 * f); };
+  ro.cancelled = cancelled;
+  t = Clock::now();
+  try {
+    const TetMesh core = std::move(out.refined);
+    out.refined = refine_quality(out.solid, core, ro, &out.rst, &out.boundary);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::kCancelled) throw;
+    rethrow_for_solid(e, model, s);
+  }
+  out.seconds_refine = seconds_since(t);
+  out.projection = projector->stats();
+  return out;
+}
+
+// Stages 2 and 3 for every solid, at most options.workers (0: the machine's cores) at a time;
+// the results do not depend on how many. Progress goes to `report` as the whole run's fraction
+// (0.1 to 1: the surface took the first tenth), serialized and never going back. The first
+// error in solid order is rethrown once all threads have stopped; an error stops the others.
+std::vector<SolidMesh> mesh_solids(const cad::CadModel& model, const cad::CadSurface& surface,
+                                   const cad::CadSurfaceStats& sst,
+                                   const std::vector<std::vector<std::int32_t>>& faces_of_solid,
+                                   const std::vector<int>& solids_of_face, const FemOptions& options,
+                                   const Report& report) {
+  const int n = model.num_solids();
+  std::vector<SolidMesh> meshed(static_cast<std::size_t>(n));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
+  std::vector<double> done(static_cast<std::size_t>(n), 0.0);
+  std::mutex mutex;  // guards next, stop, done, shown and the caller's callbacks
+  int next = 0;
+  bool stop = false;
+  double shown = 0.1;
+  const auto cancelled = [&]() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return stop || (options.cancelled && options.cancelled());
+  };
+  auto work = [&]() {
+    for (;;) {
+      int s;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (stop || next == n) return;
+        s = next++;
+      }
+      try {
+        if (cancelled()) throw MeshingError(ErrorCode::kCancelled, "fem", -1, "cancelled");
+        const Report solid_report = [&](const std::string& stage, double f) {
+          std::lock_guard<std::mutex> lock(mutex);
+          done[static_cast<std::size_t>(s)] = std::clamp(f, 0.0, 1.0);
+          double sum = 0;
+          for (double d : done) sum += d;
+          shown = std::max(shown, 0.1 + 0.9 * sum / n);
+          report(stage, shown);
+        };
+        meshed[static_cast<std::size_t>(s)] = mesh_solid(model, surface, sst, fixed_tags_of(faces_of_solid, solids_of_face, s),
+                                                         options, s, cancelled, solid_report);
+        std::lock_guard<std::mutex> lock(mutex);
+        done[static_cast<std::size_t>(s)] = 1.0;
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        errors[static_cast<std::size_t>(s)] = std::current_exception();
+        stop = true;
+      }
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int workers = std::min(n, options.workers > 0 ? options.workers : static_cast<int>(cores));
+  std::vector<std::thread> threads;
+  for (int w = 1; w < workers; ++w) threads.emplace_back(work);
+  work();
+  for (auto& thread : threads) thread.join();
+  // A solid stopped because another failed reports kCancelled: the other's error comes first.
+  std::exception_ptr first_cancel;
+  for (const auto& e : errors) {
+    if (!e) continue;
+    try {
+      std::rethrow_exception(e);
+    } catch (const Error& error) {
+      if (error.code() != ErrorCode::kCancelled) throw;
+      if (!first_cancel) first_cancel = e;
+    }
+  }
+  if (first_cancel) std::rethrow_exception(first_cancel);
+  return meshed;
+}
+
 }  // namespace
 
 void check_fem_options(const FemOptions& o) {
@@ -58,6 +206,7 @@ void check_fem_options(const FemOptions& o) {
   if (o.order != 1 && o.order != 2) bad("option order must be 1 or 2, got " + std::to_string(o.order));
   if (o.optimize_rounds < 0) bad("option optimize_rounds must be >= 0");
   if (o.face_rounds < 0) bad("option face_rounds must be >= 0");
+  if (o.workers < 0) bad("option workers must be >= 0 (0: every core)");
   for (const auto& [face, size] : o.size_by_face) {
     if (!std::isfinite(size) || size <= 0) {
       std::ostringstream what;
@@ -89,11 +238,6 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   auto report = [&](const std::string& stage, double f) {
     if (options.progress) options.progress(stage, std::clamp(f, 0.0, 1.0));
   };
-  auto check_cancel = [&] {
-    if (options.cancelled && options.cancelled())
-      throw MeshingError(ErrorCode::kCancelled, "fem", -1, "cancelled");
-  };
-
   // ---- 1. Surface. ----
   cad::CadSurfaceOptions so = cad_surface_options(options);
   so.progress = [&](const std::string& stage, double f) { report("surface: " + stage, 0.1 * f); };
@@ -118,9 +262,6 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   }
   for (int n : solids_of_face) st.shared_faces += n > 1 ? 1 : 0;
 
-  std::shared_ptr<cad::CadProjector> projector;
-  const ProjectionHook hook = cad::make_projection_hook(model, &projector);
-
   // Merged numbering: corner nodes (the CAD surface nodes first), mid-nodes apart until the end.
   std::vector<double> corner_xyz = surface.xyz;
   std::vector<Vec3> mid_xyz;
@@ -136,58 +277,15 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   std::vector<std::array<Index, 3>> tri_corners;
   const int npt = options.order == 2 ? 10 : 4;
 
-  for (int s = 0; s < n_solids; ++s) {
-    check_cancel();
-    const double share = 0.9 / n_solids, base = 0.1 + share * s;
-    const std::string name = "Solid" + std::to_string(s + 1);
-    std::vector<Index> node_of;
-    const SurfaceMesh solid = surface.solid_surface(s, &node_of);
-
-    // ---- 2. Core. ----
-    MeshOptions mo;
-    mo.progress = [&](const std::string& stage, double f) { report(name + ": " + stage, base + 0.3 * share * f); };
-    mo.cancelled = options.cancelled;
-    MeshStats mst;
-    TetMesh core;
-    t = Clock::now();
-    try {
-      core = check_and_tetrahedralize(solid, SurfaceCheckOptions{}, mo, &mst);
-    } catch (const Error& e) {
-      if (e.code() == ErrorCode::kCancelled) throw;
-      rethrow_for_solid(e, model, s);
-    }
-    st.seconds_core += seconds_since(t);
-    st.core_points += mst.points;
-    st.core_tets += mst.tets;
-    st.core_steiner_points += mst.steiner_points;
-
-    // ---- 3. Refinement. ----
-    RefineOptions ro;
-    ro.size = sst.size;
-    ro.min_size = sst.min_size;
-    for (const auto& [face, size] : options.size_by_face) ro.size_by_tag[face] = size;
-    ro.size_from_surface = true;
-    ro.grading = options.grading;
-    ro.order = options.order;
-    ro.optimize_rounds = options.optimize_rounds;
-    ro.projection = hook;
-    for (std::int32_t f : faces_of_solid[static_cast<std::size_t>(s)])
-      if (solids_of_face[static_cast<std::size_t>(f)] > 1) ro.fixed_tags.push_back(f);
-    ro.progress = [&](const std::string& stage, double f) {
-      report(name + ": " + stage, base + 0.3 * share + 0.7 * share * f);
-    };
-    ro.cancelled = options.cancelled;
-    RefineStats rst;
-    SurfaceMesh boundary;
-    TetMesh refined;
-    t = Clock::now();
-    try {
-      refined = refine_quality(solid, core, ro, &rst, &boundary);
-    } catch (const Error& e) {
-      if (e.code() == ErrorCode::kCancelled) throw;
-      rethrow_for_solid(e, model, s);
-    }
-    st.seconds_refine += seconds_since(t);
+  // ---- 2 and 3. Core and refinement of every solid, options.workers at a time (fem_mesh.h). ----
+  const std::vector<SolidMesh> meshed = mesh_solids(model, surface, sst, faces_of_solid, solids_of_face, options, report);
+  for (const SolidMesh& m : meshed) {
+    st.seconds_core += m.seconds_core;
+    st.core_points += m.mst.points;
+    st.core_tets += m.mst.tets;
+    st.core_steiner_points += m.mst.steiner_points;
+    const RefineStats& rst = m.rst;
+    st.seconds_refine += m.seconds_refine;
     st.surface_splits += rst.surface_splits;
     st.refinement_points += rst.refinement_points;
     st.interior_splits += rst.splits - rst.surface_splits;
@@ -205,6 +303,20 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.midnodes_moved_surface += rst.midnodes_moved_surface;
     st.lift_insertions += rst.lift_insertions;
     for (const auto& [pass, seconds] : rst.seconds_by_pass) st.refine_seconds_by_pass[pass] += seconds;
+    st.projection.face_calls += m.projection.face_calls;
+    st.projection.edge_calls += m.projection.edge_calls;
+    st.projection.outside_trim += m.projection.outside_trim;
+    st.projection.face_fallbacks += m.projection.face_fallbacks;
+    st.projection.no_common_edge += m.projection.no_common_edge;
+  }
+
+  for (int s = 0; s < n_solids; ++s) {
+    const std::string name = "Solid" + std::to_string(s + 1);
+    const SolidMesh& sm = meshed[static_cast<std::size_t>(s)];
+    const SurfaceMesh& solid = sm.solid;
+    const std::vector<Index>& node_of = sm.node_of;
+    const TetMesh& refined = sm.refined;
+    const SurfaceMesh& boundary = sm.boundary;
 
     // ---- 4. Merge this solid. ----
     t = Clock::now();
@@ -361,7 +473,6 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(worst.size() / 2), worst.end());
     st.median_tet_min_dihedral_deg = worst[worst.size() / 2];
   }
-  st.projection = projector->stats();
   st.seconds_total = seconds_since(start);
   report("done", 1.0);
   if (stats) *stats = st;

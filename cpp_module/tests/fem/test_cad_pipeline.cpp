@@ -292,6 +292,9 @@ TEST(CadPipeline, BadOptionsAreInputErrors) {
   o.size = 0;
   o.size_by_face[0] = 0;
   EXPECT_THROW(fem::mesh_cad_model(model, o), InputError);
+  o.size_by_face.clear();
+  o.workers = -1;
+  EXPECT_THROW(fem::mesh_cad_model(model, o), InputError);
 }
 
 class CadPipelineOrder : public ::testing::TestWithParam<int> {};
@@ -339,6 +342,28 @@ TEST_P(CadPipelineOrder, SolidsTouchingAtPoints) {
   const fem::FemMesh fm = fem::mesh_cad_model(model, o, &st);
   EXPECT_EQ(st.shared_faces, 0);
   expect_valid_fem_mesh(model, fm, st, o.order);
+}
+
+// FemOptions::workers solids at a time, each on its own thread: the same mesh, array for array,
+// for 1, 2 and 3 workers (three solids that share a curved cap and a disc).
+TEST_P(CadPipelineOrder, SolidsMeshedAtTheSameTimeGiveTheSameMesh) {
+  const cad::CadModel model = box_and_ball();
+  std::vector<fem::FemMesh> meshes;
+  for (int workers : {1, 2, 3}) {
+    fem::FemOptions o;
+    o.order = GetParam();
+    o.workers = workers;
+    fem::FemStats st;
+    meshes.push_back(fem::mesh_cad_model(model, o, &st));
+    if (workers == 2) expect_valid_fem_mesh(model, meshes.back(), st, o.order);
+  }
+  for (std::size_t i = 1; i < meshes.size(); ++i) {
+    EXPECT_EQ(meshes[i].mesh.xyz, meshes[0].mesh.xyz);
+    EXPECT_EQ(meshes[i].mesh.tet, meshes[0].mesh.tet);
+    EXPECT_EQ(meshes[i].tet_solid, meshes[0].tet_solid);
+    EXPECT_EQ(meshes[i].tri, meshes[0].tri);
+    EXPECT_EQ(meshes[i].tri_face, meshes[0].tri_face);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Orders, CadPipelineOrder, ::testing::Values(1, 2),

@@ -6,7 +6,8 @@
 // Stages, in order:
 //  1. surface: every CAD edge, then every CAD face meshed once at the size field
 //     (cad/cad_surface.h); each solid's closed surface from its faces;
-//  2. core, per solid: the exact tetrahedralization of that surface (mesher.h
+//  2. core, per solid (FemOptions::workers solids at a time, each on its own thread with its own
+//     projector; nothing is shared but the read-only model and surface): the exact tetrahedralization of that surface (mesher.h
 //     check_and_tetrahedralize: the surface is checked, self-intersections included, beside the
 //     core; no point is added on the surface);
 //  3. refine, per solid: quality_refine.h at the size field's h, sizes extended from the surface
@@ -70,6 +71,9 @@ struct FemOptions {
   int optimize_rounds = 8;
   /// Rounds of local operations per CAD face at most (cad/face_mesher.h).
   int face_rounds = 20;
+  /// Solids meshed at the same time (stages 2 and 3, one thread each); 0: the machine's cores.
+  /// The mesh is the same for every value.
+  int workers = 0;
   /// Called with (stage, fraction of the whole run in [0, 1]); may be empty.
   std::function<void(const std::string&, double)> progress;
   /// Polled between steps; return true to stop (throws MeshingError with code kCancelled).
@@ -175,6 +179,7 @@ void for_each_fem_option(F&& f) {
   f("order", &FemOptions::order);
   f("optimize_rounds", &FemOptions::optimize_rounds);
   f("face_rounds", &FemOptions::face_rounds);
+  f("workers", &FemOptions::workers);
 }
 
 /// The statistics schema, stated once: calls f(name, member pointer) for every figure of FemStats
