@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bsptet/mesh/edge_map.h"
+#include "bsptet/mesh/ring_triangulation.h"
 
 namespace bsptet {
 
@@ -362,39 +363,24 @@ bool SeedFlips::remove_edge(Index c, Index d, Index a, Index e) {
   // e < 0: any triangulation (the whole polygon, p_0 .. p_{n-1}, is the sub-polygon (0, n - 1)).
   const int k = e < 0 ? n - 1 : static_cast<int>(std::find(p.begin(), p.end(), e) - p.begin());
   if (e >= 0 && (k <= 1 || k >= n - 1)) return false;  // e must be a ring vertex not next to a
-  // ok[i][j] (i < j, j <= n; p_n = p_0): the sub-polygon p_i .. p_j has a triangulation of
-  // valid triangles; via[i][j] its apex. Triangle (p_i, p_j, p_m) in ring order: tets
-  // (c, p_i, p_j, p_m) and (d, p_j, p_i, p_m).
+  // Triangle (p_i, p_k, p_j) in ring order: tets (c, p_i, p_k, p_j) and (d, p_k, p_i, p_j); the
+  // first allowed triangulation (mesh/ring_triangulation.h) of p_0 .. p_k and of p_k .. p_n
+  // (p_n = p_0).
   auto at = [&](int i) { return p[i % n]; };
-  std::array<std::array<signed char, kMaxRing + 1>, kMaxRing + 1> ok{}, via{};
-  std::array<std::array<signed char, kMaxRing + 1>, kMaxRing + 1> known{};
-  auto triangle_ok = [&](int i, int j, int m) {
-    return positive({c, at(i), at(j), at(m)}) && positive({d, at(j), at(i), at(m)});
-  };
-  std::function<bool(int, int)> fill = [&](int i, int j) -> bool {
-    if (j == i + 1) return true;
-    if (known[i][j]) return ok[i][j] > 0;
-    known[i][j] = 1;
-    ok[i][j] = 0;
-    for (int m = i + 1; m < j && !ok[i][j]; ++m)
-      if (fill(i, m) && fill(m, j) && triangle_ok(i, m, j)) {
-        ok[i][j] = 1;
-        via[i][j] = static_cast<signed char>(m);
-      }
-    return ok[i][j] > 0;
-  };
-  if (!fill(0, k) || (e >= 0 && !fill(k, n))) return false;
+  auto ring_polygon = make_ring_triangulation(
+      n + 1, 0.0, 1.0,
+      [&](int i, int m, int j, double) {
+        return positive({c, at(i), at(m), at(j)}) && positive({d, at(m), at(i), at(j)}) ? 1.0 : -1.0;
+      },
+      [](int, int) { return true; });
+  if (ring_polygon.best(0, k) <= 0 || (e >= 0 && ring_polygon.best(k, n) <= 0)) return false;
   std::vector<Tet> made;
-  std::function<void(int, int)> emit = [&](int i, int j) {
-    if (j == i + 1) return;
-    const int m = via[i][j];
+  const auto emit = [&](int i, int m, int j) {
     made.push_back({c, at(i), at(m), at(j)});
     made.push_back({d, at(m), at(i), at(j)});
-    emit(i, m);
-    emit(m, j);
   };
-  emit(0, k);
-  if (e >= 0) emit(k, n);
+  ring_polygon.for_each_triangle(0, k, emit);
+  if (e >= 0) ring_polygon.for_each_triangle(k, n, emit);
   replace(ring, made);
   return true;
 }

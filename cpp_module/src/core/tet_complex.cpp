@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "bsptet/mesh/ring_triangulation.h"
 #include "bsptet/numerics/predicates.h"
 
 namespace bsptet {
@@ -1019,27 +1020,27 @@ bool TetComplex::remove_edge(Index v, Index x) {
     ring.push_back(it->second);
   }
   if (next[ring.back()] != ring[0]) return false;
-  // Triangulations of the ring polygon, enumerated recursively (fan-first order).
+  // The first triangulation of the ring polygon whose triangles (p, q, r) give positive tets
+  // (p, q, r, x) and (p, r, q, v), in apex order (mesh/ring_triangulation.h); each triangle
+  // tested costs 2 of work.
+  const int m = static_cast<int>(n);
+  auto ring_polygon = make_ring_triangulation(
+      m, 0.0, 1.0,
+      [&](int i, int k, int j, double) {
+        work += 2;
+        const Index p = ring[static_cast<std::size_t>(i)], q = ring[static_cast<std::size_t>(k)],
+                    r = ring[static_cast<std::size_t>(j)];
+        return geo_.orient3d(p, q, r, x) == Sign::kPositive && geo_.orient3d(p, r, q, v) == Sign::kPositive ? 1.0 : -1.0;
+      },
+      [](int, int) { return true; });
+  if (ring_polygon.best(0, m - 1) <= 0) return false;
   std::vector<std::array<Index, 4>> repl;
-  std::function<bool(std::vector<Index>)> solve = [&](std::vector<Index> poly) -> bool {
-    const std::size_t m = poly.size();
-    if (m < 3) return true;
-    // The triangle on edge (poly[0], poly[m-1]) with apex poly[k].
-    for (std::size_t k = 1; k + 1 < m; ++k) {
-      const Index p = poly[0], q = poly[k], r = poly[m - 1];
-      work += 2;
-      if (geo_.orient3d(p, q, r, x) != Sign::kPositive || geo_.orient3d(p, r, q, v) != Sign::kPositive) continue;
-      const std::size_t mark = repl.size();
-      repl.push_back({p, q, r, x});
-      repl.push_back({p, r, q, v});
-      if (solve(std::vector<Index>(poly.begin(), poly.begin() + static_cast<std::ptrdiff_t>(k + 1))) &&
-          solve(std::vector<Index>(poly.begin() + static_cast<std::ptrdiff_t>(k), poly.end())))
-        return true;
-      repl.resize(mark);
-    }
-    return false;
-  };
-  if (!solve(ring)) return false;
+  ring_polygon.for_each_triangle(0, m - 1, [&](int i, int k, int j) {
+    const Index p = ring[static_cast<std::size_t>(i)], q = ring[static_cast<std::size_t>(k)],
+                r = ring[static_cast<std::size_t>(j)];
+    repl.push_back({p, q, r, x});
+    repl.push_back({p, r, q, v});
+  });
   std::sort(around.begin(), around.end());
   if (!tets_are_new(repl, around)) return false;
   for (Index id : around) kill_tet(id);

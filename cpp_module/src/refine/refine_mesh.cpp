@@ -10,6 +10,7 @@
 
 #include "bsptet/numerics/errors.h"
 #include "bsptet/numerics/predicates.h"
+#include "bsptet/mesh/ring_triangulation.h"
 #include "bsptet/mesh/tet_shape.h"
 
 namespace bsptet {
@@ -663,6 +664,7 @@ bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAc
 bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>& shell, const std::vector<Index>& ring,
                                      bool open, Index parent, const TetsAccept& accept) {
   const int n = static_cast<int>(ring.size());
+  if (n > kMaxRingVertices) return false;
   {
     std::vector<Index> sorted = ring;
     std::sort(sorted.begin(), sorted.end());
@@ -677,57 +679,37 @@ bool RefineMesh::retriangulate_shell(Index u, Index v, const std::vector<Index>&
   // checked (0, n - 1) for an open chain); the single triangle of n = 3 must not be a mesh face.
   // A diagonal is looked up only for a sub-polygon that has a triangulation good enough to be
   // used (most have none), which gives the same optimum as checking every diagonal first.
-  const auto diagonal_ok = [&](int i, int j) { return (i == 0 && j == n - 1) || !edge_exists(W(i), W(j)); };
+  const auto diagonal_ok = [&](int i, int j) { return !edge_exists(W(i), W(j)); };
   if (n == 3)
     for (Index s : tets_around_edge(W(0), W(1)))
       if (std::find(tet(s).begin(), tet(s).end(), W(2)) != tet(s).end()) return false;
-  // best[i][j]: the best worst angle of a triangulation of the sub-polygon i..j (j - i >= 2);
-  // -1: none is valid.
-  const double kNone = -1;
   double old_min = 180;
   for (Index s : shell) old_min = std::min(old_min, tet_quality(s));
   // Without `accept` only a triangulation better than the shell counts: a sub-polygon whose best
   // is no better than that is as good as none (the same optimum, found with fewer tets looked at).
-  const double floor_q = accept ? kNone : old_min + kImprovement;
-  std::vector<double> best(static_cast<std::size_t>(n * n), std::numeric_limits<double>::infinity());
-  std::vector<int> choice(static_cast<std::size_t>(n * n), -1);
-  for (int len = 2; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
-      double b = floor_q;
-      int c = -1;
-      for (int k = i + 1; k < j; ++k) {
-        const double left = best[static_cast<std::size_t>(i * n + k)], right = best[static_cast<std::size_t>(k * n + j)];
-        if (left <= kNone || right <= kNone) continue;
-        double q = std::min(left, right);
-        if (q <= b) continue;
+  // A triangle's score is the worst angle of its two tets (mesh/ring_triangulation.h).
+  const double kNone = -1;
+  auto ring_polygon = make_ring_triangulation(
+      n, accept ? kNone : old_min + kImprovement, std::numeric_limits<double>::infinity(),
+      [&](int i, int k, int j, double bar) {
+        double q = std::numeric_limits<double>::infinity();
         for (const auto& t : tets_of(i, k, j)) {
-          if (!positive(t)) {
-            q = kNone;
-            break;
-          }
+          if (!positive(t)) return kNone;
           q = std::min(q, quality_of(t));
-          if (q <= b) break;
+          if (q <= bar) break;
         }
-        if (q > b) b = q, c = k;
-      }
-      if (c >= 0 && !diagonal_ok(i, j)) c = -1;
-      best[static_cast<std::size_t>(i * n + j)] = c < 0 ? kNone : b;
-      choice[static_cast<std::size_t>(i * n + j)] = c;
-    }
-  // (Without `accept`, a result is better than the shell by construction: floor_q above.)
-  if (best[static_cast<std::size_t>(n - 1)] <= kNone) return false;
+        return q;
+      },
+      diagonal_ok);
+  // (Without `accept`, a result is better than the shell by construction: the floor above.)
+  if (ring_polygon.best(0, n - 1) <= kNone) return false;
   std::vector<std::array<Index, 4>> created;
-  std::vector<std::pair<int, int>> todo{{0, n - 1}};
-  while (!todo.empty()) {
-    const auto [i, j] = todo.back();
-    todo.pop_back();
-    if (j - i < 2) continue;
-    const int k = choice[static_cast<std::size_t>(i * n + j)];
-    for (const auto& t : tets_of(i, k, j)) created.push_back(t);
-    todo.emplace_back(i, k);
-    todo.emplace_back(k, j);
-  }
+  ring_polygon.for_each_triangle(
+      0, n - 1,
+      [&](int i, int k, int j) {
+        for (const auto& t : tets_of(i, k, j)) created.push_back(t);
+      },
+      /*right_first=*/true);
   if (accept) {
     std::vector<std::array<Index, 4>> removed;
     for (Index s : shell) removed.push_back(tet(s));
