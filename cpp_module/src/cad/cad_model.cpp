@@ -15,8 +15,18 @@
 #include <Bnd_Box.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
+#include <Interface_EntityIterator.hxx>
+#include <Interface_Graph.hxx>
 #include <STEPControl_Reader.hxx>
+#include <StepBasic_Product.hxx>
+#include <StepBasic_ProductDefinition.hxx>
+#include <StepBasic_ProductDefinitionFormation.hxx>
+#include <StepRepr_CharacterizedDefinition.hxx>
+#include <StepRepr_PropertyDefinition.hxx>
 #include <StepRepr_RepresentationItem.hxx>
+#include <StepRepr_RepresentedDefinition.hxx>
+#include <StepShape_ManifoldSolidBrep.hxx>
+#include <StepShape_ShapeDefinitionRepresentation.hxx>
 #include <Standard_Failure.hxx>
 #include <TCollection_HAsciiString.hxx>
 #include <TopExp.hxx>
@@ -46,24 +56,6 @@ std::string lower_extension(const std::string& path) {
   throw InputError(ErrorCode::kBadArgument, kStage, -1, source + ": " + what);
 }
 
-// The names a STEP file gives the entities its shapes were made from, by TShape (so every
-// placement of an instanced part gets its part's names).
-using ShapeNames = std::unordered_map<const TopoDS_TShape*, std::string>;
-
-TopoDS_Shape read_step(const std::string& path, ShapeNames& names) {
-  STEPControl_Reader reader;
-  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) fail(path, "not a readable STEP file");
-  reader.TransferRoots();
-  const Handle(Transfer_TransientProcess) process = reader.WS()->TransferReader()->TransientProcess();
-  for (int i = 1; !process.IsNull() && i <= process->NbMapped(); ++i) {
-    const auto item = Handle(StepRepr_RepresentationItem)::DownCast(process->Mapped(i));
-    if (item.IsNull() || item->Name().IsNull() || item->Name()->Length() == 0) continue;
-    const TopoDS_Shape made = TransferBRep::ShapeResult(process, item);
-    if (!made.IsNull()) names.emplace(made.TShape().get(), item->Name()->ToCString());
-  }
-  return reader.OneShape();
-}
-
 // A CAD name as a set name (see cad_model.h), "" when it is not one.
 std::string set_name(const std::string& cad_name) {
   std::string name;
@@ -77,6 +69,62 @@ std::string set_name(const std::string& cad_name) {
   std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
   const bool letter = std::any_of(name.begin(), name.end(), [](unsigned char c) { return std::isalpha(c); });
   return letter && upper != "NONE" ? name : "";
+}
+
+// The names a STEP file gives the entities its shapes were made from, by TShape (so every
+// placement of an instanced part gets its part's names).
+using ShapeNames = std::unordered_map<const TopoDS_TShape*, std::string>;
+
+// The name of the product (part) whose shape representation holds `item`: the first
+// SHAPE_DEFINITION_REPRESENTATION met going up from it through the entities that refer to it
+// (at most 4 steps: the brep's representation, a representation relationship, ...); "" if none.
+std::string product_name(const Interface_Graph& graph, const Handle(Standard_Transient)& item) {
+  std::vector<Handle(Standard_Transient)> level{item};
+  std::set<const Standard_Transient*> seen{item.get()};
+  for (int depth = 0; depth < 4 && !level.empty(); ++depth) {
+    std::vector<Handle(Standard_Transient)> up;
+    for (const auto& entity : level) {
+      Interface_EntityIterator it = graph.Sharings(entity);
+      for (it.Start(); it.More(); it.Next()) {
+        const Handle(Standard_Transient)& user = it.Value();
+        if (!seen.insert(user.get()).second) continue;
+        const auto sdr = Handle(StepShape_ShapeDefinitionRepresentation)::DownCast(user);
+        if (sdr.IsNull()) {
+          up.push_back(user);
+          continue;
+        }
+        const Handle(StepRepr_PropertyDefinition) property = sdr->Definition().PropertyDefinition();
+        if (property.IsNull()) continue;
+        const Handle(StepBasic_ProductDefinition) definition = property->Definition().ProductDefinition();
+        if (definition.IsNull() || definition->Formation().IsNull() || definition->Formation()->OfProduct().IsNull())
+          continue;
+        const Handle(TCollection_HAsciiString) name = definition->Formation()->OfProduct()->Name();
+        return name.IsNull() ? "" : name->ToCString();
+      }
+    }
+    level = std::move(up);
+  }
+  return "";
+}
+
+TopoDS_Shape read_step(const std::string& path, ShapeNames& names) {
+  STEPControl_Reader reader;
+  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) fail(path, "not a readable STEP file");
+  reader.TransferRoots();
+  const Handle(Transfer_TransientProcess) process = reader.WS()->TransferReader()->TransientProcess();
+  for (int i = 1; !process.IsNull() && i <= process->NbMapped(); ++i) {
+    const auto item = Handle(StepRepr_RepresentationItem)::DownCast(process->Mapped(i));
+    if (item.IsNull()) continue;
+    std::string name = item->Name().IsNull() ? "" : item->Name()->ToCString();
+    // A solid without a name of its own (assemblies often give ids such as "#1345") takes its
+    // part's product name.
+    if (set_name(name).empty() && item->IsKind(STANDARD_TYPE(StepShape_ManifoldSolidBrep)))
+      name = product_name(reader.WS()->Graph(), item);
+    if (name.empty()) continue;
+    const TopoDS_Shape made = TransferBRep::ShapeResult(process, item);
+    if (!made.IsNull()) names.emplace(made.TShape().get(), name);
+  }
+  return reader.OneShape();
 }
 
 std::string upper_case(std::string s) {

@@ -11,7 +11,8 @@
 //
 // Names, for the outputs' sets: solid k is "Solid<k+1>" and face k "Face<k+1>" (FreeCAD's
 // names), unless a STEP file names the entity (MANIFOLD_SOLID_BREP, ADVANCED_FACE, ...: the
-// name of the representation item the shape was made from). A STEP name is kept when it holds a
+// name of the representation item the shape was made from; a solid whose item has no such name
+// takes the name of the product, the part, it belongs to). A STEP name is kept when it holds a
 // letter and is not "NONE"; characters other than letters, digits, '-' and '_' become '_', and
 // it is cut at 48 characters (CalculiX and MED allow 80 in a set name); a name
 // that several entities share, or that equals another name up to case (solvers such as CalculiX
