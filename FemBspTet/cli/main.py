@@ -3,6 +3,7 @@
 
     fembsptet mesh INPUT -o OUTPUT [-o OUTPUT ...] [--size H] [--min-size L] [--radius-edge B]
                    [--min-dihedral D] [--thickness-ratio K] [--surface-points exact|rounded] [--order 1|2]
+                   [--dimension 2|3]
                    [--stats-json FILE] [--quiet] [--reorient] [--write-intersections FILE]
                    [--max-memory SIZE] [--out-of-core] [--workers N] [--scheduler ADDRESS]
                    [--timeout SECONDS]
@@ -33,7 +34,7 @@ from ..compare.benchmark import model_paths, run_benchmark, write_report
 from ..compare.comparison import (compare, format_rows, format_table, MESHERS, plot_histograms,
                                   row_from_stats, tetgen_pY_row, write_json)
 from ..fem.cad_check import check_against_cad
-from ..fem.cad_mesh import mesh_cad_file
+from ..fem.cad_mesh import mesh_cad_faces_file, mesh_cad_file
 from ..freecad.femmesh import read_via_freecad, write_via_freecad
 from ..io.atomic_file import atomic_output
 from ..io.cad_tessellation import tessellate_file
@@ -47,7 +48,7 @@ from ..io.volume_io import (MSH_VERSIONS, read_tet_mesh, stored_points, surface_
 from ..kernel import core
 from ..kernel.errors import InputError, report_errors, SelfIntersectionError
 from ..kernel.memory_budget import default_budget, parse_size
-from ..kernel.mesh_types import Surface, TetMesh
+from ..kernel.mesh_types import MeshGroups, Surface, TetMesh
 from ..kernel.progress import Progress
 from ..peers.process import DEFAULT_TIMEOUT
 from .addon_install import install
@@ -118,7 +119,7 @@ def _check_stored(path, mesh):
 
     points = stored_points(path, mesh.points)
     changed = (points != mesh.points).any(axis=1)
-    if not changed.any():
+    if not changed.any() or len(mesh.tets) == 0:  # a 2D mesh has no tets to invert
         return
     stored = TetMesh(points, mesh.tets, source=mesh.source)
     report = core.check_mesh(core.boundary_surface(stored), stored, max_messages=3,
@@ -156,6 +157,14 @@ def _check_mesh_args(args):
             raise InputError(f"--{name.replace('_', '-')} must be a positive number, got {value}")
     if args.thickness_ratio is not None and not (args.thickness_ratio >= 0 and math.isfinite(args.thickness_ratio)):
         raise InputError(f"--thickness-ratio must be 0 (off) or a positive number, got {args.thickness_ratio}")
+    if args.dimension == 2:
+        if _ext(args.input) not in CAD_EXTENSIONS or getattr(args, "tessellation", False):
+            raise InputError("--dimension 2 meshes the faces of a CAD file (.step .brep .iges); "
+                             "a triangle surface is already 2D", where=args.input)
+        for out in args.output:
+            if _ext(out) in (".node", ".ele"):
+                raise InputError("TetGen's .node / .ele hold tetrahedra; write a 2D mesh as "
+                                 ".vtu, .msh, .inp or .mesh", where=out)
     if args.timeout is not None and not (args.timeout > 0 and math.isfinite(args.timeout)):
         raise InputError(f"--timeout must be a positive number of seconds, got {args.timeout}")
     if args.write_intersections is not None:
@@ -213,9 +222,17 @@ def _mesh_cad_fem(args, progress):
                          "OpenCASCADE's display tessellation with the core instead",
                          where=args.input)
 
-    result = mesh_cad_file(args.input, progress=progress,
-                           **{option: getattr(args, dest) for dest, option in
-                              FEM_OPTION_OF_FLAG.items()})
+    options = {option: getattr(args, dest) for dest, option in FEM_OPTION_OF_FLAG.items()}
+    if args.dimension == 2:
+        faces = mesh_cad_faces_file(args.input, progress=progress, **options)
+        # A 2D mesh: no tets; the elements are the groups' triangles (volume_io.write_tet_mesh).
+        columns = 10 if faces.triangles.shape[1] == 6 else 4
+        groups = MeshGroups(face_triangles=faces.triangles, face_tags=faces.face_tags,
+                            face_names=faces.groups.face_names,
+                            tet_solid=np.zeros(0, dtype=np.int32), solid_names=[])
+        return (TetMesh(faces.points, np.zeros((0, columns), dtype=np.int64), source=args.input),
+                faces.stats, groups)
+    result = mesh_cad_file(args.input, progress=progress, **options)
     return result.mesh, result.stats, result.groups
 
 
@@ -347,20 +364,31 @@ def mesh_summary(source, outputs, mesh, stats, groups):
     else:
         lines.append(f"read     {source}: {_count(stats.get('input_points', 0))} points, "
                      f"{_count(stats.get('input_triangles', 0))} triangles")
-    kind = "tet10" if order == 2 else "tet4"
-    written = f"{_count(len(mesh.points))} nodes, {_count(len(mesh.tets))} {kind} elements"
+    two_d = len(mesh.tets) == 0 and groups is not None and len(groups.face_triangles) > 0
+    if two_d:  # the elements are the CAD faces' triangles
+        kind = "tria6" if groups.face_triangles.shape[1] == 6 else "tria3"
+        elements = len(groups.face_triangles)
+    else:
+        kind = "tet10" if order == 2 else "tet4"
+        elements = len(mesh.tets)
+    written = f"{_count(len(mesh.points))} nodes, {_count(elements)} {kind} elements"
     if groups is not None:
         faces = len(np.unique(groups.face_tags))
         solids = 1 if groups.tet_solid is None else len(np.unique(groups.tet_solid))
-        written += f"; sets: {faces} CAD face(s), {solids} solid(s)"
+        written += f"; sets: {faces} CAD face(s)" + ("" if two_d else f", {solids} solid(s)")
     for out in outputs:
         lines.append(f"wrote    {out}: {written}")
     if not outputs:
         lines.append(f"made     {written} (no file written: give -o FILE)")
-    quality = f"quality  worst dihedral {stats.get('min_dihedral_deg', float('nan')):.1f} deg"
+    if two_d:
+        quality = (f"quality  smallest triangle angle {stats['min_triangle_angle_deg']:.1f} deg, "
+                   f"median per-triangle smallest {stats['median_triangle_min_angle_deg']:.1f} "
+                   "deg")
+    else:
+        quality = f"quality  worst dihedral {stats.get('min_dihedral_deg', float('nan')):.1f} deg"
     if stats.get("p1_dihedral_deg") is not None:
         quality += f", 1% of angles under {stats['p1_dihedral_deg']:.1f}"
-    if "median_tet_min_dihedral_deg" in stats:
+    if "median_tet_min_dihedral_deg" in stats and not two_d:
         quality += (f", median per-tet worst {stats['median_tet_min_dihedral_deg']:.1f} deg, "
                     f"{stats.get('tets_below_10_deg', 0.0):.2f}% under 10 deg")
     if stats.get("max_radius_edge_ratio") is not None:
@@ -373,6 +401,8 @@ def mesh_summary(source, outputs, mesh, stats, groups):
         ("surface", "seconds_surface"), ("core", "seconds_core"), ("refine", "seconds_refine"),
         ("merge", "seconds_merge"), ("writing", "seconds_writing")) if key in stats]
     total = stats.get("seconds_total", 0.0)
+    if two_d:  # no volume stages
+        parts = [(k, v) for k, v in parts if k in ("surface", "writing")]
     if not fem_path:  # the core's stages: the four longest
         stages = sorted((stats.get("seconds_by_stage") or {}).items(), key=lambda kv: -kv[1])
         parts = [(k.replace("_", " "), v) for k, v in stages[:4] if v >= 0.005] + \
@@ -614,7 +644,11 @@ def build_parser():
                         "where no double lies on them; rounded: rounded midpoints everywhere "
                         "(boundary within rounding of the input, checked against itself)")
     m.add_argument("--order", type=int, choices=(1, 2), default=1,
-                   help="element order (2: 10-node tets)")
+                   help="element order (2: 10-node tets, 6-node triangles in 2D)")
+    m.add_argument("--dimension", type=int, choices=(2, 3), default=3,
+                   help="CAD input: 3 (default) the solids as tetrahedra; 2 every CAD face (of a "
+                        "Face, a Shell or solids) as triangles, for shell and plane analyses "
+                        "(.inp: S3 / S6 elements, a node and an element set per face)")
     m.add_argument("--stats-json", default=None, help="write the run's statistics here (JSON)")
     m.add_argument("--quiet", action="store_true", help="no progress and no summary")
     m.add_argument("--msh-version", choices=MSH_VERSIONS, default="2.2",

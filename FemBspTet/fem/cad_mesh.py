@@ -221,12 +221,25 @@ def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, ca
     triangles at the size field, tria6 mid-nodes on the CAD (``cpp_module/include/bsptet/fem/
     fem_faces.h``): shell and plane analyses, on one thread (``workers`` is accepted for the
     3D path's sake and not used). Raises InputError (no face, bad option) or MeshingError."""
+    return _faces(lambda **kw: native().mesh_cad_brep(brep, dimension=2, **kw), source, size,
+                  min_size, order, progress, cancel, size_by_face, workers)
+
+
+def mesh_cad_faces_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=None,
+                        size_by_face=None, workers=None):
+    """The same for the faces in a STEP, BREP or IGES file (the command line's
+    ``--dimension 2``)."""
+    return _faces(lambda **kw: native().mesh_cad_file(str(path), dimension=2, **kw), str(path),
+                  size, min_size, order, progress, cancel, size_by_face, workers)
+
+
+def _faces(native_call, source, size, min_size, order, progress, cancel, size_by_face, workers):
     options = fem_options(source, size=size, min_size=min_size, order=order,
                           size_by_face=size_by_face, workers=workers)
     with core_errors(Surface(points=np.zeros((0, 3)), triangles=np.zeros((0, 3), dtype=np.int64),
                              source=""), "FEM surface mesh"):
-        points, _tets, _solid, tri, tri_face, stats, _solid_names, face_names = native().mesh_cad_brep(
-            brep, dimension=2, options=options,
+        points, _tets, _solid, tri, tri_face, stats, _solid_names, face_names = native_call(
+            options=options,
             progress=(lambda stage, fraction: progress(stage, fraction)) if progress else None,
             cancel=cancel)
     points = np.asarray(points)

@@ -271,13 +271,16 @@ def _format_of(path):
 def write_via_freecad(path, mesh, groups=None):
     """Write ``mesh`` (a :class:`TetMesh`; with the faces and groups of ``groups``, a
     MeshGroups, when given) with FreeCAD's writer chosen by the extension of ``path``: the
-    FemMesh of :func:`tetmesh_to_femmesh`, written by :func:`write_femmesh`.
+    FemMesh of :func:`tetmesh_to_femmesh` (of :func:`triangles_to_femmesh` for a 2D mesh: no
+    tets, the groups' triangles), written by :func:`write_femmesh`.
 
     Raises InputError for an unsupported extension, a missing or unwritable directory, or an
     invalid mesh; InternalError if FreeCAD's writer fails or writes nothing.
     """
     path = os.fspath(path)
     _check_target(path)
+    if len(mesh.tets) == 0 and groups is not None:  # a 2D mesh: the faces' triangles
+        return write_femmesh(path, triangles_to_femmesh(mesh.points, groups, source=path))
     return write_femmesh(path, tetmesh_to_femmesh(mesh, groups))
 
 

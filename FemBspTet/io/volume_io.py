@@ -129,6 +129,11 @@ def write_tet_mesh(path, mesh, groups=None, msh_version="2.2"):
     doc); :func:`surface_groups` makes them from a tagged surface. ``.node`` / ``.ele`` write
     both TetGen files. ``msh_version``: "2.2" (read by every tool that reads MSH) or "4.1"
     (Gmsh 4's own).
+
+    A mesh with no tets whose ``groups`` hold the CAD faces' triangles is a 2D mesh: the
+    triangles (tria3, or tria6 when ``mesh.tets`` has 10 columns) are its elements (``.inp``:
+    S3 / S6 shells in ``Eall``, a node set and an element set of each face's name); TetGen
+    files need tets.
     """
     path = os.fspath(path)
     ext = _extension(path)
@@ -143,6 +148,9 @@ def write_tet_mesh(path, mesh, groups=None, msh_version="2.2"):
         writers[ext] = _write_msh41
     points, tets = _checked_mesh(mesh)
     sets = None if groups is None else _checked_groups(path, groups, points, tets)
+    if len(tets) == 0 and ext in (".node", ".ele"):
+        raise InputError("TetGen's .node / .ele hold tetrahedra; write a 2D mesh as .vtu, .msh, "
+                         ".inp or .mesh", where=path)
     writers[ext](path, points, tets, sets)
 
 
@@ -736,7 +744,8 @@ def _write_msh41(path, points, tets, sets):
             out.write(f"{t + 1} {box(tets[solid == t])} 1 {t + 1} 0\n")
         out.write("$EndEntities\n")
         n = len(points)
-        out.write(f"$Nodes\n1 {n} 1 {n}\n3 {int(solids[0]) + 1} 0 {n}\n")
+        home = f"3 {int(solids[0]) + 1}" if len(solids) else f"2 {int(faces[0]) + 1}"  # 2D: a face
+        out.write(f"$Nodes\n1 {n} 1 {n}\n{home} 0 {n}\n")
         out.write(_format_rows("%d\n", np.arange(1, n + 1).reshape(-1, 1)))
         out.write(_format_rows("%r %r %r\n", points))
         out.write("$EndNodes\n")
@@ -1185,6 +1194,8 @@ def _write_id_lines(out, ids):
 
 
 def _write_inp(path, points, tets, sets):
+    if len(tets) == 0 and sets is not None:
+        return _write_inp_shells(path, points, sets)
     k = tets.shape[1]
     etype = "C3D4" if k == 4 else "C3D10"
     m = len(tets)
@@ -1192,11 +1203,7 @@ def _write_inp(path, points, tets, sets):
         out.write(f"** {_GENERATOR}\n")
         out.write(f"** {len(points)} nodes, {m} {etype} elements; node order and orientation "
                   f"as CalculiX expects\n")
-        out.write("*NODE, NSET=Nall\n")
-        coords = np.empty(points.shape, dtype=object)
-        coords[:] = [[_inp_number(v) for v in row] for row in points.tolist()]
-        out.write(_format_rows("%d, %s, %s, %s\n",
-                               _mixed_rows(np.arange(1, len(points) + 1), coords)))
+        _write_inp_nodes(out, points)
         out.write(f"*ELEMENT, TYPE={etype}, ELSET=Eall\n")
         rows = np.column_stack([np.arange(1, m + 1), tets + 1])
         # at most 16 entries per data line; a line ending in ',' continues on the next
@@ -1225,6 +1232,37 @@ def _write_inp(path, points, tets, sets):
             out.write(f"*SURFACE, NAME={name}, TYPE=ELEMENT\n")
             pairs = np.column_stack([tet_of[rows] + 1, side[rows] + 1])
             out.write(_format_rows("%d, S%d\n", pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]))
+
+
+def _write_inp_nodes(out, points):
+    out.write("*NODE, NSET=Nall\n")
+    coords = np.empty(points.shape, dtype=object)
+    coords[:] = [[_inp_number(v) for v in row] for row in points.tolist()]
+    out.write(_format_rows("%d, %s, %s, %s\n", _mixed_rows(np.arange(1, len(points) + 1), coords)))
+
+
+def _write_inp_shells(path, points, sets):
+    """A 2D mesh: the CAD faces' triangles as CalculiX S3 / S6 shell elements (corners, then
+    mid-nodes m12 m23 m31: our order), per face an element set and a node set of its name."""
+    etype = "S3" if sets.tri.shape[1] == 3 else "S6"
+    m = len(sets.tri)
+    with atomic_output(path, "w") as out:
+        out.write(f"** {_GENERATOR}\n")
+        out.write(f"** {len(points)} nodes, {m} {etype} elements (give them a *SHELL SECTION)\n")
+        _write_inp_nodes(out, points)
+        out.write(f"*ELEMENT, TYPE={etype}, ELSET=Eall\n")
+        out.write(_format_rows(" ".join(["%d,"] * sets.tri.shape[1]) + " %d\n",
+                               np.column_stack([np.arange(1, m + 1), sets.tri + 1])))
+        faces = sets.faces()
+        names = _inp_names([sets.face_names[t] for t in faces.tolist()], {"NALL", "EALL"})
+        out.write("** per CAD face an element set and a node set (corner and mid-edge nodes) of "
+                  "the same name\n")
+        for t, name in zip(faces.tolist(), names):
+            rows = np.flatnonzero(sets.tags == t)
+            out.write(f"*ELSET, ELSET={name}\n")
+            _write_id_lines(out, rows + 1)
+            out.write(f"*NSET, NSET={name}\n")
+            _write_id_lines(out, np.unique(sets.tri[rows]) + 1)
 
 
 _INP_TET_TYPES = re.compile(r"C3D(4|10)[A-Z]*$")
@@ -1510,11 +1548,12 @@ def _write_medit(path, points, tets, sets):
             rows = np.column_stack([sets.tri + 1, sets.tags + 1])
             out.write(f"\n{keyword}\n{len(sets.tri)}\n")
             out.write(_format_rows(" ".join(["%d"] * rows.shape[1]) + "\n", rows))
-        keyword = "Tetrahedra" if k == 4 else "TetrahedraP2"
-        solid = np.zeros(len(tets), dtype=np.int64) if sets is None else sets.solid
-        rows = np.column_stack([tets + 1, solid + 1])
-        out.write(f"\n{keyword}\n{len(tets)}\n")
-        out.write(_format_rows(" ".join(["%d"] * (k + 1)) + "\n", rows))
+        if len(tets):
+            keyword = "Tetrahedra" if k == 4 else "TetrahedraP2"
+            solid = np.zeros(len(tets), dtype=np.int64) if sets is None else sets.solid
+            rows = np.column_stack([tets + 1, solid + 1])
+            out.write(f"\n{keyword}\n{len(tets)}\n")
+            out.write(_format_rows(" ".join(["%d"] * (k + 1)) + "\n", rows))
         out.write("\nEnd\n")
 
 
