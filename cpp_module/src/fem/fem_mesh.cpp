@@ -12,6 +12,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
 #include "bsptet/cad/cad_projection.h"
@@ -170,7 +171,11 @@ std::vector<SolidMesh> mesh_solids(const cad::CadModel& model, const cad::CadSur
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const int workers = std::min(n, options.workers > 0 ? options.workers : static_cast<int>(cores));
   std::vector<std::thread> threads;
-  for (int w = 1; w < workers; ++w) threads.emplace_back(work);
+  try {
+    for (int w = 1; w < workers; ++w) threads.emplace_back(work);
+  } catch (const std::system_error&) {
+    // no more threads to be had: the ones started and this one share the solids
+  }
   work();
   for (auto& thread : threads) thread.join();
   // A solid stopped because another failed reports kCancelled: the other's error comes first.
