@@ -97,6 +97,7 @@ def test_2d_needs_a_cad_file_and_a_2d_format(tmp_path):
     assert main(["mesh", off, "--dimension", "2", "-o", str(tmp_path / "c.vtu")],
                 supervise=False) == 2
     assert run(["-o", str(tmp_path / "m.node")]) == 2
+    assert run(["-o", str(tmp_path / "m.vtu"), "--compare-tetgen"]) == 2
     assert not os.listdir(tmp_path)
 
 

@@ -165,6 +165,8 @@ def _check_mesh_args(args):
             if _ext(out) in (".node", ".ele"):
                 raise InputError("TetGen's .node / .ele hold tetrahedra; write a 2D mesh as "
                                  ".vtu, .msh, .inp or .mesh", where=out)
+        if getattr(args, "compare_tetgen", False):
+            raise InputError("--compare-tetgen compares volume meshes; drop it with --dimension 2")
     if args.timeout is not None and not (args.timeout > 0 and math.isfinite(args.timeout)):
         raise InputError(f"--timeout must be a positive number of seconds, got {args.timeout}")
     if args.write_intersections is not None:
