@@ -23,17 +23,22 @@
 //   STEM (needed). Without --no-check each piece's mesh is checked exactly against its own surface
 //   (which checks the whole mesh in one piece's memory) instead of the whole mesh at the end.
 //
-// The input is checked first (surface_check.h: also self-intersections, non-manifold vertices and
-// shells facing the wrong way); --reorient flips triangles as that check allows.
+// The input is checked (surface_check.h: also self-intersections, non-manifold vertices and
+// shells facing the wrong way; the self-intersection search runs beside the core, or beside the
+// cut and the pieces, and stops them when it finds a crossing); --reorient flips triangles as that
+// check allows.
 //
 // Exit: 0 valid mesh, 1 meshing error or invalid mesh, 2 bad input.
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
+#include <thread>
 
 #include "bsptet/numerics/errors.h"
 #include "bsptet/mesh/mesh_check.h"
@@ -140,9 +145,34 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "--pieces, --max-piece-triangles, --max-memory and --workers write the mesh as they go: give --write STEM\n");
         return 2;
       }
+      // The check but its self-intersection search first; the search runs beside the cut and
+      // the pieces (as check_and_tetrahedralize runs it beside the core) and stops them when it
+      // finds a crossing.
       t0 = Clock::now();
-      s.tri = check_surface(s, check).tri;
+      SurfaceCheckOptions first = check;
+      first.self_intersections = false;
+      s.tri = check_surface(s, first).tri;
       const double check_s = since(t0);
+      std::atomic<bool> crossed{false};
+      std::exception_ptr search_error;
+      std::thread searcher([&] {
+        try {
+          check_self_intersections(s, check);
+        } catch (...) {
+          search_error = std::current_exception();
+          crossed = true;
+        }
+      });
+      o.cancelled = [&] { return crossed.load(); };
+      // Rethrows the search's error (the pieces' files removed) once it is done.
+      auto join_search = [&] {
+        searcher.join();
+        if (search_error) {
+          std::remove((stem + ".node").c_str());
+          std::remove((stem + ".ele").c_str());
+          std::rethrow_exception(search_error);
+        }
+      };
       PieceOptions po;
       po.check_pieces = !no_check;
       po.workers = workers;
@@ -152,10 +182,16 @@ int main(int argc, char** argv) {
                                                   : piece_triangles_for_workers(s.num_triangles(), workers);
       if (o.progress) po.log = [](const std::string& line) { std::fprintf(stderr, "[%s]\n", line.c_str()); };
       PieceStats ps;
-      tetrahedralize_in_pieces(s, o, po, stem, &ps);
+      try {
+        tetrahedralize_in_pieces(s, o, po, stem, &ps);
+      } catch (...) {
+        join_search();
+        throw;
+      }
+      join_search();
       for (const auto& line : ps.uncut) std::fprintf(stderr, "warning: %s\n", line.c_str());
       std::printf("%s: %s tets %lld points %lld steiner %lld pieces %lld (largest %lld triangles, at most %lld) cuts %lld "
-                  "(refused %lld) cap_triangles %lld cap_points %lld\n  program: read %.3f s  check %.3f s  cutting %.3f s  meshing "
+                  "(refused %lld) cap_triangles %lld cap_points %lld\n  program: read %.3f s  check (its search beside) %.3f s  cutting %.3f s  meshing "
                   "%.3f s  writing %.3f s\n",
                   argv[1], no_check ? "UNCHECKED" : "VALID (each piece checked exactly)", static_cast<long long>(ps.tets),
                   static_cast<long long>(ps.points), static_cast<long long>(ps.steiner_points),
