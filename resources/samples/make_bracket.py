@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Makes bracket.step, the sample part of scripts/demo.sh (our own model, LGPL like the project).
 
 An L-shaped steel bracket, 80 x 40 x 50 mm, 8 mm thick, with two bolt holes in each flange and a

@@ -103,6 +103,11 @@ SolidMesh mesh_solid(const cad::CadModel& model, const cad::CadSurface& surface,
   ro.optimize_rounds = options.optimize_rounds;
   ro.projection = hook;
   ro.fixed_tags = fixed_tags;
+  // Nodes inside a CAD face slide along it during smoothing (those of a shared face stay: the
+  // refinement keeps fixed tags' nodes).
+  ro.sliding_points.assign(out.node_of.size(), 0);
+  for (std::size_t i = 0; i < out.node_of.size(); ++i)
+    ro.sliding_points[i] = surface.node_dim[static_cast<std::size_t>(out.node_of[i])] == 2;
   ro.progress = [&](const std::string& stage, double f) { report(name + ": " + stage, 0.3 + 0.7 * f); };
   ro.cancelled = cancelled;
   t = Clock::now();
@@ -327,12 +332,19 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     t = Clock::now();
     // The core and the refinement keep the input points first, in order (mesher.h,
     // quality_refine.h): the solid's surface nodes are the CAD nodes node_of[i].
+    // A node inside a CAD face that only this solid has may have slid along the face.
     const Index n_surface = solid.num_points();
-    for (Index i = 0; i < n_surface; ++i)
-      if (i >= refined.num_points() || !same(refined.point(i), solid.point(i)))
+    for (Index i = 0; i < n_surface; ++i) {
+      const std::size_t cad_node = static_cast<std::size_t>(node_of[static_cast<std::size_t>(i)]);
+      if (i < refined.num_points() && same(refined.point(i), solid.point(i))) continue;
+      if (i >= refined.num_points() || surface.node_dim[cad_node] != 2 ||
+          solids_of_face[static_cast<std::size_t>(surface.node_entity[cad_node])] != 1)
         throw MeshingError(ErrorCode::kInternal, "fem", i,
                            model.source + ": " + name + ": surface node " + std::to_string(i) +
                                " is not at its place in the refined mesh");
+      const Vec3 p = refined.point(i);
+      corner_xyz[3 * cad_node] = p.x, corner_xyz[3 * cad_node + 1] = p.y, corner_xyz[3 * cad_node + 2] = p.z;
+    }
     std::vector<Index> corner_of(static_cast<std::size_t>(refined.num_points()), -1);
     for (Index i = 0; i < n_surface; ++i) corner_of[static_cast<std::size_t>(i)] = node_of[static_cast<std::size_t>(i)];
     const Index nk = refined.num_tets();

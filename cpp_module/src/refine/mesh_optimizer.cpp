@@ -21,6 +21,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // flat_collapse_pass works on the tets below this min dihedral angle (degrees).
 constexpr double kFlatCollapseBelowDeg = 1.0;
+// A surface point slides (MeshOptimizer::odt_move) only when the mean angle around it rises by
+// at least this many degrees: each slide costs a search on the CAD surface.
+constexpr double kSlideGainDeg = 0.1;
+// ... and only when a tet around it is below this many degrees.
+constexpr double kSlideBelowDeg = 40.0;
 // ODT smoothing (MeshOptimizer::odt_smooth_pass) never takes a tet below this or below the worst
 // before.
 constexpr double kOdtKeepDeg = 15.0;
@@ -238,9 +243,20 @@ std::int64_t MeshOptimizer::odt_smooth_pass(int sweeps) {
 
 // One point's move of odt_smooth_pass; marks the corners of its tets in moved_near when it moves.
 bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
-  if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
+  if (!m_.point_alive(v)) return false;
+  const bool slides = m_.slides(v);
+  if (!slides && m_.support(v).kind != Support::kInterior) return false;
   const std::vector<Index> ball = m_.tets_around_point(v);
   if (ball.empty()) return false;
+  if (slides) {
+    if (slide_failed_.size() < static_cast<std::size_t>(m_.num_points()))
+      slide_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
+    std::uint64_t& failed = slide_failed_[static_cast<std::size_t>(v)];
+    std::uint64_t stamp = 0;
+    for (Index t : ball) stamp = std::max(stamp, m_.tet_stamp(t));
+    if (failed != 0 && stamp <= failed) return false;
+    failed = std::max<std::uint64_t>(m_.clock(), 1);  // cleared below when it moves
+  }
   double wsum = 0, mean_before = 0, worst_before = 180;
   Vec3 x{0, 0, 0};
   bool ok = true;
@@ -262,6 +278,7 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
     worst_before = std::min(worst_before, m_.tet_quality(t));
   }
   if (!ok || !(wsum > 0)) return false;
+  if (slides && worst_before >= kSlideBelowDeg) return false;
   x = {x.x / wsum, x.y / wsum, x.z / wsum};
   mean_before /= static_cast<double>(ball.size());
   const double keep = std::min(worst_before, kOdtKeepDeg);
@@ -272,19 +289,37 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
       if (q < keep) return false;
       mean += q;
     }
-    return mean / static_cast<double>(moved.size()) > mean_before + 1e-9;
+    return mean / static_cast<double>(moved.size()) > mean_before + (slides ? kSlideGainDeg : 1e-9);
   };
   const Vec3 p = m_.point(v);
-  // All the way, else half way, towards y; marks v's neighbours when v moved.
+  // All the way, else half way, towards y (a sliding point: then back onto its face); marks v's
+  // neighbours when v moved.
   const auto move_towards = [&](const Vec3& y) {
-    for (double f : {1.0, 0.5})
-      if (m_.relocate_point_if(v, {p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)}, accept)) {
+    for (double f : {1.0, 0.5}) {
+      const Vec3 q{p.x + f * (y.x - p.x), p.y + f * (y.y - p.y), p.z + f * (y.z - p.z)};
+      if (slides ? m_.slide_point_if(v, q, accept) : m_.relocate_point_if(v, q, accept)) {
         for (Index t : ball)
           for (Index w : m_.tet(t)) (*moved_near)[static_cast<std::size_t>(w)] = 1;
+        if (slides) slide_failed_[static_cast<std::size_t>(v)] = 0;
         return true;
       }
+    }
     return false;
   };
+  if (slides) {
+    // A surface point: towards the centroid of its boundary neighbours (the surface mesh evened
+    // out along the face), else the ODT point, each put back on its face. Over the CAD corpus at
+    // h = diagonal / 20, tet10, the median per-tet worst angle rose by 0.06 degree with the
+    // centroid alone, 0.33 with the ODT point alone, 0.43 with both.
+    const std::vector<Index> around = m_.boundary_neighbours(v);
+    if (!around.empty()) {
+      Vec3 c{0, 0, 0};
+      for (Index w : around) c.x += m_.point(w).x, c.y += m_.point(w).y, c.z += m_.point(w).z;
+      const double k = static_cast<double>(around.size());
+      if (move_towards({c.x / k, c.y / k, c.z / k})) return true;
+    }
+    return move_towards(x);
+  }
   if (move_towards(x)) return true;
   // Then the centroid of its neighbours (Laplacian smoothing), where the ODT point is refused:
   // next to the surface the ODT point is pulled by the large circumspheres of the boundary

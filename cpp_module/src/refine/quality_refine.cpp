@@ -214,6 +214,7 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
   RefineStats st;
   RefineMesh m(surface, mesh, options.projection, options.surface_points);
   m.set_fixed_tags(options.fixed_tags);
+  m.set_sliding_points(options.sliding_points);
   Refiner(m, options, st).run();
   if (boundary) {
     std::vector<Index> old_to_new;

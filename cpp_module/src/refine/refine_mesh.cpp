@@ -341,6 +341,135 @@ void RefineMesh::set_fixed_tags(std::vector<std::int32_t> tags) {
   fixed_tags_ = std::move(tags);
 }
 
+void RefineMesh::set_sliding_points(const std::vector<char>& input_points) {
+  slide_tag_.assign(xyz_.size(), -1);
+  if (!hook_ || surface_.tag.empty()) return;
+  // The one tag of each input point's triangles (-2: more than one).
+  std::vector<std::int32_t> tag(static_cast<std::size_t>(surface_.num_points()), -1);
+  for (Index t = 0; t < surface_.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      std::int32_t& g = tag[static_cast<std::size_t>(surface_.tri[static_cast<std::size_t>(3 * t + k)])];
+      const std::int32_t tt = surface_.tag[static_cast<std::size_t>(t)];
+      g = g == -1 || g == tt ? tt : -2;
+    }
+  std::map<std::array<double, 3>, Index> index_of;
+  for (Index i = 0; i < surface_.num_points(); ++i) {
+    const Vec3 p = surface_.point(i);
+    index_of.emplace(std::array<double, 3>{p.x, p.y, p.z}, i);
+  }
+  for (Index v = 0; v < num_points(); ++v) {
+    if (support(v).kind != Support::kInputVertex || !point_alive(v)) continue;
+    const Vec3& p = point(v);
+    const auto it = index_of.find({p.x, p.y, p.z});
+    if (it == index_of.end()) continue;
+    const std::size_t i = static_cast<std::size_t>(it->second);
+    if (i >= input_points.size() || !input_points[i] || tag[i] < 0) continue;
+    if (std::binary_search(fixed_tags_.begin(), fixed_tags_.end(), tag[i])) continue;
+    slide_tag_[static_cast<std::size_t>(v)] = tag[i];
+  }
+}
+
+std::vector<Index> RefineMesh::boundary_neighbours(Index v) {
+  std::vector<Index> out;
+  for (Index t : tets_around_point(v)) {
+    const auto& q = tet(t);
+    for (int k = 0; k < 4; ++k) {
+      const Index a = q[(k + 1) % 4], b = q[(k + 2) % 4], c = q[(k + 3) % 4];
+      if (q[k] == v || !boundary_.count(face_key(a, b, c))) continue;
+      for (Index w : {a, b, c})
+        if (w != v) out.push_back(w);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Smallest angle of triangle abc, degrees.
+double triangle_min_angle_deg(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const auto angle = [](const Vec3& o, const Vec3& x, const Vec3& y) {
+    const double ux = x.x - o.x, uy = x.y - o.y, uz = x.z - o.z, wx = y.x - o.x, wy = y.y - o.y, wz = y.z - o.z;
+    const double cx = uy * wz - uz * wy, cy = uz * wx - ux * wz, cz = ux * wy - uy * wx;
+    return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz) * 180.0 / kPi;
+  };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+// Unit normal of triangle abc (zero when degenerate).
+Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z, wx = c.x - a.x, wy = c.y - a.y, wz = c.z - a.z;
+  Vec3 n{uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx};
+  const double l = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+  return l > 0 ? Vec3{n.x / l, n.y / l, n.z / l} : Vec3{0, 0, 0};
+}
+
+}  // namespace
+
+bool RefineMesh::slide_point_if(Index v, const Vec3& target,
+                                const std::function<bool(const std::vector<std::array<Vec3, 4>>&)>& accept) {
+  if (!slides(v) || !finite(target)) return false;
+  const std::vector<Index> ball = tets_around_point(v);
+  std::vector<std::array<Vec3, 4>> moved(ball.size());
+  const double min_cos = std::cos(kSlideMaxTiltDeg * kPi / 180.0);
+  // All the checks with v at p; the angles only rank, positivity is exact.
+  const auto passes = [&](const Vec3& p) {
+    double worst_before = 180, worst_after = 180;
+    for (std::size_t i = 0; i < ball.size(); ++i) {
+      const auto& t = tet(ball[i]);
+      if (!positive_with(t, v, p)) return false;
+      for (int k = 0; k < 4; ++k) moved[i][static_cast<std::size_t>(k)] = t[k] == v ? p : point(t[k]);
+      for (int k = 0; k < 4; ++k) {
+        if (t[k] == v) continue;
+        const Index a = t[(k + 1) % 4], b = t[(k + 2) % 4], c = t[(k + 3) % 4];
+        if (!boundary_.count(face_key(a, b, c))) continue;
+        const auto at = [&](Index w) { return w == v ? p : point(w); };
+        worst_before = std::min(worst_before, triangle_min_angle_deg(point(a), point(b), point(c)));
+        worst_after = std::min(worst_after, triangle_min_angle_deg(at(a), at(b), at(c)));
+        const Vec3 n0 = unit_normal(point(a), point(b), point(c)), n1 = unit_normal(at(a), at(b), at(c));
+        if (n0.x * n1.x + n0.y * n1.y + n0.z * n1.z < min_cos) return false;
+      }
+    }
+    return worst_after >= std::min(worst_before, kSlideKeepTriangleDeg) && accept(moved);
+  };
+  // The target's move along the surface (its component along the area-weighted normal of the
+  // boundary faces around v taken off) is tried first: the hook (a search on the CAD surface)
+  // runs only for a move likely to be taken, and its answer is then checked again.
+  const Vec3 old = point(v);
+  Vec3 n{0, 0, 0};
+  for (Index t : ball) {
+    const auto& q = tet(t);
+    for (int k = 0; k < 4; ++k) {
+      if (q[k] == v) continue;
+      static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // types.h
+      const Index a = q[outward[k][0]], b = q[outward[k][1]], c = q[outward[k][2]];
+      if (!boundary_.count(face_key(a, b, c))) continue;
+      const Vec3 &A = point(a), &B = point(b), &C = point(c);
+      const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, wx = C.x - A.x, wy = C.y - A.y, wz = C.z - A.z;
+      n.x += uy * wz - uz * wy, n.y += uz * wx - ux * wz, n.z += ux * wy - uy * wx;
+    }
+  }
+  const double nn = n.x * n.x + n.y * n.y + n.z * n.z;
+  Vec3 along = target;
+  if (nn > 0) {
+    const double d = ((target.x - old.x) * n.x + (target.y - old.y) * n.y + (target.z - old.z) * n.z) / nn;
+    along = {target.x - d * n.x, target.y - d * n.y, target.z - d * n.z};
+  }
+  if (!passes(along)) return false;
+  const Vec3 p = hook_(along, slide_tag_[static_cast<std::size_t>(v)], -1);
+  if (!finite(p) || (p.x == old.x && p.y == old.y && p.z == old.z) || !passes(p)) return false;
+  xyz_[static_cast<std::size_t>(v)] = p;
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    const auto& c = moved[i];
+    quality_[static_cast<std::size_t>(ball[i])] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
+    touch(tet(ball[i]));
+  }
+  return true;
+}
+
 SplitOutcome RefineMesh::split_edge(Index u, Index v, double min_quality, Index* new_point) {
   const std::vector<Index> shell = tets_around_edge(u, v);
   if (shell.empty()) return SplitOutcome::kNoEdge;

@@ -391,6 +391,51 @@ TEST(CadPipeline, NoTetUnderTenDegreesWhereTheCadHasNoSharpAngle) {
   }
 }
 
+// Smoothing slides the CAD nodes inside a face along it (the mesh's first nodes are the CAD
+// surface's, mesh_cad_model's numbering); nodes on CAD edges and vertices, and every node of a
+// face two solids share, stay where the surface mesher put them. Where the moved nodes lie is
+// checked by expect_valid_fem_mesh (on their CAD face within its tolerance).
+TEST(CadPipeline, NodesInsideFacesSlideOthersStay) {
+  struct Case {
+    cad::CadModel model;
+    bool has_shared;
+  };
+  std::vector<Case> cases;
+  cases.push_back({cad::read_cad_file(data("cad/bracket.step")), false});
+  cases.push_back({box_and_ball(), true});
+  for (const Case& c : cases) {
+    fem::FemOptions o;
+    o.order = 2;
+    fem::FemStats st;
+    const fem::FemMesh fm = fem::mesh_cad_model(c.model, o, &st);
+    expect_valid_fem_mesh(c.model, fm, st, o.order);
+    const cad::CadSurface surface = cad::mesh_cad_surface(c.model, fem::cad_surface_options(o));
+    std::vector<int> solids_of_face(static_cast<std::size_t>(c.model.num_faces()), 0);
+    for (const auto& tags : surface.solid_tag) {
+      std::set<std::int32_t> faces(tags.begin(), tags.end());
+      for (std::int32_t f : faces) ++solids_of_face[static_cast<std::size_t>(f)];
+    }
+    std::int64_t inside = 0, slid = 0, shared_inside = 0;
+    for (std::size_t i = 0; i < surface.node_dim.size(); ++i) {
+      const Vec3 cad{surface.xyz[3 * i], surface.xyz[3 * i + 1], surface.xyz[3 * i + 2]};
+      const Vec3 now = fm.mesh.point(static_cast<Index>(i));
+      const bool moved = cad.x != now.x || cad.y != now.y || cad.z != now.z;
+      const bool shared = surface.node_dim[i] == 2 && solids_of_face[static_cast<std::size_t>(surface.node_entity[i])] > 1;
+      if (surface.node_dim[i] != 2 || shared) {
+        EXPECT_FALSE(moved) << c.model.source << ": node " << i << " (dimension " << int(surface.node_dim[i])
+                            << (shared ? ", on a shared face" : "") << ") moved";
+        shared_inside += shared;
+      } else {
+        ++inside;
+        slid += moved;
+      }
+    }
+    // Most nodes inside faces move a little: the surface mesher's layout is not the volume's best.
+    EXPECT_GT(slid, inside / 4) << c.model.source << ": " << slid << " of " << inside;
+    EXPECT_EQ(shared_inside > 0, c.has_shared) << c.model.source;
+  }
+}
+
 TEST(CadPipeline, CancelledRunThrows) {
   const cad::CadModel model = cad::read_cad_file(data("cad/red_cube_blue_cylinder.step"));
   fem::FemOptions o;

@@ -122,8 +122,9 @@ class MeshOptimizer {
   std::int64_t collapse_pass();
   /// Collapses Steiner corners of the tets below `below` degrees whatever their edge lengths.
   std::int64_t flat_collapse_pass(double below);
-  /// ODT smoothing: a sweep over every interior point, then up to sweeps - 1 more over the
-  /// neighbours of the points the previous sweep moved.
+  /// ODT smoothing: a sweep over every interior point and every sliding surface point
+  /// (RefineMesh::slides), then up to sweeps - 1 more over the neighbours of the points the
+  /// previous sweep moved.
   std::int64_t odt_smooth_pass(int sweeps);
   /// Moves the interior corners of the tets below `below` degrees (smooth_point).
   std::int64_t smooth_pass(double below);
@@ -135,8 +136,10 @@ class MeshOptimizer {
   std::int64_t radius_edge_pass();
 
   // ---- Single operations ----
-  /// odt_smooth_pass's move of interior point v (the ODT point, else its neighbours' centroid);
-  /// when it moves, sets moved_near[w] for every corner w of its tets. True when v moved.
+  /// odt_smooth_pass's move of interior point v (the ODT point, else its neighbours' centroid)
+  /// or of sliding surface point v (its boundary neighbours' centroid, else the ODT point, each
+  /// put back on its face; not tried again until a tet around it changes after it failed); when
+  /// it moves, sets moved_near[w] for every corner w of its tets. True when v moved.
   bool odt_move(Index v, std::vector<char>* moved_near);
   /// Moves interior point v to the first position that raises the worst tet around it; true when
   /// it moved.
@@ -167,6 +170,7 @@ class MeshOptimizer {
   RefineStats& st_;
   TargetSizes& size_;
   FailureMemory flip_failed_, insert_failed_;
+  std::vector<std::uint64_t> slide_failed_;  // per point: the clock when its slide last failed
   std::vector<Index> shell_;  // flip_pass: scratch for a shell
 };
 

@@ -118,6 +118,11 @@ struct RefineOptions {
   int optimize_rounds = 8;   ///< optimization rounds at most
   /// Moves every new surface point onto the true surface; empty: see surface_points.
   ProjectionHook projection;
+  /// With a projection hook: the input points (flags indexed like the surface's points) that
+  /// the smoothing may slide along their true surface face, the hook putting them back on it
+  /// (RefineMesh::set_sliding_points). The FEM path flags the CAD nodes inside a face that no
+  /// other solid shares; a point on a CAD edge or vertex never moves. Empty: none moves.
+  std::vector<char> sliding_points;
   /// Without a hook: kExact (default) puts points on the surface only where a double lies exactly
   /// on the facet (the output tiles the input exactly; elsewhere surface edges stay long);
   /// kRounded takes rounded midpoints (refines every facet; boundary within rounding of the input).

@@ -141,6 +141,16 @@ class RefineMesh {
   /// The tags set_fixed_tags kept, sorted.
   const std::vector<std::int32_t>& fixed_tags() const { return fixed_tags_; }
 
+  /// Projection mode only: input points that may slide along their true surface face.
+  /// `input_points` is indexed like the input surface's points; a flagged point slides when its
+  /// input triangles all have one tag, not a fixed one (the caller flags only points inside one
+  /// CAD face: a point on a CAD edge or vertex must stay). Without a hook nothing slides.
+  void set_sliding_points(const std::vector<char>& input_points);
+  /// Whether point v may slide (set_sliding_points).
+  bool slides(Index v) const {
+    return static_cast<std::size_t>(v) < slide_tag_.size() && slide_tag_[static_cast<std::size_t>(v)] >= 0;
+  }
+
   // ---- Operations: each checked exactly, applied only when valid --------------------------------
   /// Splits edge (u, v) at a point near its midpoint (see the file comment for the surface rules).
   /// `min_quality`: the split is refused (kInverted) when a new tet's min dihedral would be below
@@ -226,6 +236,21 @@ class RefineMesh {
   bool relocate_point_if(Index v, const Vec3& p,
                          const std::function<bool(const std::vector<std::array<Vec3, 4>>&)>& accept);
 
+  /// Moves a sliding point v (slides(v)) to the hook's image of `target` on its face, when the
+  /// hook answers a finite point, every tet around v stays positive (exact), no boundary
+  /// triangle around v tilts by more than kSlideMaxTiltDeg or gets a smallest angle below
+  /// min(the worst of them before, kSlideKeepTriangleDeg), and `accept` returns true for the
+  /// moved tets (as relocate_point_if); the target itself must pass the same checks first, so
+  /// the hook (a search on the CAD surface) runs only for a move likely to be taken. Validity is
+  /// what it is for any point: positive tets, the boundary's combinatorics unchanged; the
+  /// boundary stays on the true surface.
+  bool slide_point_if(Index v, const Vec3& target,
+                      const std::function<bool(const std::vector<std::array<Vec3, 4>>&)>& accept);
+  /// The other corners of the boundary faces around point v (sorted, unique).
+  std::vector<Index> boundary_neighbours(Index v);
+  static constexpr double kSlideMaxTiltDeg = 20.0;
+  static constexpr double kSlideKeepTriangleDeg = 25.0;
+
   // ---- Output ----------------------------------------------------------------------------------
   /// The live tets and the points they use: input points first, at their input indices order kept
   /// as in the mesh given to the constructor, then the others in creation order. `old_to_new`
@@ -262,6 +287,7 @@ class RefineMesh {
   const SurfaceMesh& surface_;
   ProjectionHook hook_;
   std::vector<std::int32_t> fixed_tags_;  ///< sorted
+  std::vector<std::int32_t> slide_tag_;   ///< per point: the face tag it slides on, else -1
   SurfacePoints surface_points_;
   std::vector<Vec3> xyz_;
   std::vector<PointSupport> support_;
