@@ -35,7 +35,8 @@
 //     three times its size after step 1). A tet on which every flip (or every insertion
 //     candidate) failed is not tried again until a tet around one of its corners changes
 //     (RefineMesh change stamps). Rounds stop when nothing changes
-//     or the worst dihedral reaches `min_dihedral_deg`. Input points and the surface never move.
+//     or the worst dihedral reaches `min_dihedral_deg`. Input points never move, except those
+//     flagged in `sliding_points` (with a hook): the ODT sweeps slide them along their face.
 //  2b. separate_face_tags (optional): see the option;
 //  2c. order 2 with a projection hook: room for curved elements (interior points lifted off the
 //     curved faces, or reconnected), then the tets below 15 degrees polished by flips, moves and

@@ -24,6 +24,8 @@
 // input facets, on purpose: only the combinatorics stay a refinement (each boundary face keeps its
 // parent and face tag) and validity means positive tets, conforming faces and a closed boundary.
 // A projected point that would make a tet non-positive is rejected (the edge is not split).
+// Input points the caller flags may also slide along their face (slide_point_if), put back on it
+// by the hook, under the same exact positivity check.
 #pragma once
 
 #include <array>
@@ -39,7 +41,8 @@ namespace bsptet {
 
 /// Where a mesh point lies with respect to the input surface.
 enum class Support : std::uint8_t {
-  kInputVertex,  ///< an input point: never moved or removed
+  kInputVertex,  ///< an input point: never removed; moved only along its true surface face when
+                 ///< it slides (projection mode, set_sliding_points)
   kInputEdge,    ///< inside an input edge: moves only along it
   kInputFace,    ///< inside an input triangle: moves only within its closed triangle
   kInterior,     ///< strictly inside the solid
