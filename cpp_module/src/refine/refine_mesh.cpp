@@ -461,13 +461,18 @@ bool RefineMesh::slide_point_if(Index v, const Vec3& target,
   if (!passes(along)) return false;
   const Vec3 p = hook_(along, slide_tag_[static_cast<std::size_t>(v)], -1);
   if (!finite(p) || (p.x == old.x && p.y == old.y && p.z == old.z) || !passes(p)) return false;
+  move_point(v, p, ball, moved);
+  return true;
+}
+
+void RefineMesh::move_point(Index v, const Vec3& p, const std::vector<Index>& ball,
+                            const std::vector<std::array<Vec3, 4>>& moved) {
   xyz_[static_cast<std::size_t>(v)] = p;
   for (std::size_t i = 0; i < ball.size(); ++i) {
     const auto& c = moved[i];
     quality_[static_cast<std::size_t>(ball[i])] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
     touch(tet(ball[i]));
   }
-  return true;
 }
 
 SplitOutcome RefineMesh::split_edge(Index u, Index v, double min_quality, Index* new_point) {
@@ -1052,12 +1057,7 @@ bool RefineMesh::relocate_point_if(Index v, const Vec3& p,
     for (int k = 0; k < 4; ++k) moved[i][static_cast<std::size_t>(k)] = t[k] == v ? p : point(t[k]);
   }
   if (!accept(moved)) return false;
-  xyz_[static_cast<std::size_t>(v)] = p;
-  for (std::size_t i = 0; i < ball.size(); ++i) {
-    const auto& c = moved[i];
-    quality_[static_cast<std::size_t>(ball[i])] = tet_min_dihedral_deg(c[0], c[1], c[2], c[3]);
-    touch(tet(ball[i]));
-  }
+  move_point(v, p, ball, moved);
   return true;
 }
 

@@ -274,6 +274,8 @@ class RefineMesh {
   void kill_tet(Index t);
   void touch(const std::array<Index, 4>& t);  ///< a change to tet t: its corners get a new stamp
   Index add_point(const Vec3& p, const PointSupport& s);
+  /// Puts point v at p: `ball` its live tets, `moved` their corners with v at p (checked).
+  void move_point(Index v, const Vec3& p, const std::vector<Index>& ball, const std::vector<std::array<Vec3, 4>>& moved);
   bool positive(const std::array<Index, 4>& t) const;
   bool positive_with(const std::array<Index, 4>& t, Index moved, const Vec3& p) const;
   double quality_of(const std::array<Index, 4>& t) const;
