@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // bsptet_fem: a CAD file to a tetrahedral FEM mesh (fem/fem_mesh.h), with its figures.
 //
-//   bsptet_fem PART.step [--size H] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]
+//   bsptet_fem PART.step [--size H] [--min-size HMIN] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]
 //
 // Prints the sizes, counts, dihedral angles (smallest, median of each tet's smallest, share of
 // tets under 10 degrees; the refinement's worst at its stages, RefineStats::worst_deg_*) and
@@ -23,7 +23,7 @@
 
 int main(int argc, char** argv) {
   using namespace bsptet;
-  const char* usage = "usage: bsptet_fem PART [--size H] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]\n";
+  const char* usage = "usage: bsptet_fem PART [--size H] [--min-size HMIN] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]\n";
   if (argc < 2) {
     std::fprintf(stderr, "%s", usage);
     return 2;
@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--size") && i + 1 < argc) {
       options.size = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--min-size") && i + 1 < argc) {
+      options.min_size = std::atof(argv[++i]);
     } else if (!std::strcmp(argv[i], "--order") && i + 1 < argc) {
       options.order = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--workers") && i + 1 < argc) {
@@ -76,8 +78,8 @@ int main(int argc, char** argv) {
                 (long long)st.corner_nodes, (long long)st.tets, (long long)st.boundary_triangles);
     std::printf("  dihedral: min %.2f deg, median per-tet worst %.2f deg, tets under 10 deg %.2f%%\n",
                 st.min_dihedral_deg, st.median_tet_min_dihedral_deg, 100.0 * st.tets_below_10_deg);
-    std::printf("  worst dihedral in the refinement: optimized %.2f, room for curved elements %.2f, end %.2f deg\n",
-                st.refine_worst_deg_optimized, st.refine_worst_deg_curving_room, st.refine_worst_deg);
+    std::printf("  worst dihedral in the refinement: optimized %.2f, end %.2f deg\n", st.refine_worst_deg_optimized,
+                st.refine_worst_deg);
     std::printf("  projection: face %lld (outside trim %lld, fallbacks %lld) edge %lld (no common edge %lld)\n",
                 (long long)st.projection.face_calls, (long long)st.projection.outside_trim,
                 (long long)st.projection.face_fallbacks, (long long)st.projection.edge_calls,

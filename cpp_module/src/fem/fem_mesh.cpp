@@ -306,7 +306,6 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
     st.midnodes_straightened += rst.midnodes_straightened;
     st.curving_conflicts_left += rst.curving_conflicts_left;
     st.refine_worst_deg_optimized = std::min(st.refine_worst_deg_optimized, rst.worst_deg_optimized);
-    st.refine_worst_deg_curving_room = std::min(st.refine_worst_deg_curving_room, rst.worst_deg_curving_room);
     st.refine_worst_deg = std::min(st.refine_worst_deg, rst.worst_deg);
     st.midnodes_relaxed_tets += rst.midnodes_relaxed_tets;
     st.midnodes_moved_interior += rst.midnodes_moved_interior;

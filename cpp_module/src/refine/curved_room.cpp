@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The quality stage's room for curved tet10 elements (curved_room.h).
+// The quality stage's polish that keeps room for curved tet10 elements (curved_room.h).
 #include "bsptet/refine/curved_room.h"
 
 #include <algorithm>
@@ -87,20 +87,18 @@ bool CurvedRoom::reconnect_for_curving(Index t, const CurvedOk& curved_ok, const
   return false;
 }
 
-// With a projection hook and order 2, each boundary mid-node goes onto the true surface, off its
-// chord by the chord's sag. A tet whose interior apex stands lower over its boundary face than
-// that sag becomes an invalid curved element with straight interior mid-nodes (make_second_order
-// then has to move mid-nodes or insert a point, tet10.h). Such apexes (interior Steiner points only) are lifted towards
-// the height of a regular tet over the face, when every tet around stays positive (exact), the
-// number of invalid curved elements around goes down, and no tet around drops below
-// min(floor_deg_, the worst before): a valid curved mesh is worth a worse linear angle there.
-// Failing that, a new interior point above one of the tet's faces (Bowyer-Watson), accepted when
-// all its new tets are valid curved elements of at least floor_deg_. All this runs twice: first
-// with floor_deg_ = kCurvingGoodDeg, then with 1 degree for the elements that first pass left
-// (t20_data: taking the first change down to 1 degree left a 3.3 degree tet where it need not
-// have, and the mesh ended at 5.7 degrees; with the two passes, 8 to 9). Splitting the sagging edges
-// instead was tried and made more invalid elements (docs/design/quality-stage.md). Sets
-// curving_conflicts_left.
+// The fallback of curved_room.h. With a projection hook and order 2, each boundary mid-node goes
+// onto the true surface, off its chord by the chord's sag. A tet whose interior apex stands lower
+// over its boundary face than that sag becomes an invalid curved element with straight interior
+// mid-nodes. Such apexes (interior Steiner points only) are lifted towards the height of a
+// regular tet over the face, when every tet around stays positive (exact), the number of invalid
+// curved elements around goes down, and no tet around drops below min(floor_deg_, the worst
+// before): a valid curved mesh is worth a worse linear angle there. Failing that, a new interior
+// point above one of the tet's faces (Bowyer-Watson), accepted when all its new tets are valid
+// curved elements of at least floor_deg_. All this runs twice: first with floor_deg_ =
+// kCurvingGoodDeg, then with 1 degree for the elements that first pass left. Splitting the
+// sagging edges instead was tried and made more invalid elements (docs/design/quality-stage.md).
+// Sets curving_conflicts_left.
 void CurvedRoom::lift() {
   if (!o_.projection || o_.order != 2) return;
   prepare_check();
@@ -267,18 +265,18 @@ bool CurvedRoom::element_ok(const std::array<Index, 4>& q, const std::array<Vec3
   return !curved || certify_tet10(x) == Tet10Validity::kCertified;
 }
 
-// After the lifts (curved tet10 through a hook): the tets below `below` degrees, worst first,
-// get 3-2 and 2-3 flips, edge removals, moves of their interior corners (towards their
-// neighbours' centroid, then steepest ascent), collapses of their interior Steiner corners and
-// new interior points (insert_keeping_curved).
-// A change is applied when the worst tet it makes is better than the worst it replaces and the
-// curved elements it makes invalid are not more than those it removes (the lifts and insertions
-// for curved elements accept down to 1 degree; this takes the worst back up). Input points and
-// the surface never move. Rounds while something changes and the mesh's worst tet rose in one of
-// the last kPolishPatienceRounds rounds (at most kPolishMaxRounds); returns the changes made. No
-// change lowers the worst tet it replaces, so the mesh's worst never drops here. (At most 4
-// rounds left t20_data at 6.3 degrees where its worst was still rising: 8.1 after 16.)
+// Curved tet10 through a hook: the tets below `below` degrees, worst first, get 3-2 and 2-3
+// flips, edge removals, moves of their interior corners (towards their neighbours' centroid, then
+// steepest ascent), collapses of their interior Steiner corners and new interior points
+// (insert_keeping_curved). A change is applied when the worst tet it makes is better than the
+// worst it replaces and the curved elements it makes invalid are not more than those it removes.
+// Input points and the surface never move. Rounds while something changes and the mesh's worst
+// tet rose in one of the last kPolishPatienceRounds rounds (at most kPolishMaxRounds); returns the
+// changes made. No change lowers the worst tet it replaces, so the mesh's worst never drops here.
+// Then counts the invalid curved elements left (curving_conflicts_left).
 std::int64_t CurvedRoom::polish(double below) {
+  if (!o_.projection || o_.order != 2) return 0;
+  prepare_check();
   const TetsAccept accept = [&](const std::vector<std::array<Index, 4>>& removed,
                                 const std::vector<std::array<Index, 4>>& created) {
     double worst_before = 180;
@@ -361,6 +359,9 @@ std::int64_t CurvedRoom::polish(double below) {
     idle = now_worst > worst ? 0 : idle + 1;
     worst = now_worst;
   }
+  st_.curving_conflicts_left = 0;
+  for (Index t = 0; t < m_.num_tet_slots(); ++t)
+    if (m_.tet_alive(t) && !element_ok(m_.tet(t), corner_points(m_, m_.tet(t)))) ++st_.curving_conflicts_left;
   return changes;
 }
 

@@ -103,9 +103,9 @@ struct FemStats {
   std::int64_t midnodes_relaxed_tets = 0, midnodes_moved_interior = 0, midnodes_moved_surface = 0;
   std::int64_t lift_insertions = 0;
   /// The refinement's worst dihedral angle (degrees, least over the solids) when its optimization
-  /// is done, after it made room for curved elements, and at its end (RefineStats::worst_deg_*);
-  /// the last equals min_dihedral_deg (the merge keeps the refined corners).
-  double refine_worst_deg_optimized = 180, refine_worst_deg_curving_room = 180, refine_worst_deg = 180;
+  /// is done and at its end (RefineStats::worst_deg_*); the last equals min_dihedral_deg (the
+  /// merge keeps the refined corners).
+  double refine_worst_deg_optimized = 180, refine_worst_deg = 180;
   // Merge (stage 4).
   std::int64_t midnodes_reconciled = 0;  ///< shared mid-nodes two solids placed differently (put on the chord)
   std::int64_t midnodes_straightened_at_merge = 0;  ///< mid-nodes put on their chord after that
@@ -211,7 +211,6 @@ void for_each_fem_stat(F&& f) {
   f("midnodes_moved_surface", &FemStats::midnodes_moved_surface);
   f("lift_insertions", &FemStats::lift_insertions);
   f("refine_worst_deg_optimized", &FemStats::refine_worst_deg_optimized);
-  f("refine_worst_deg_curving_room", &FemStats::refine_worst_deg_curving_room);
   f("refine_worst_deg", &FemStats::refine_worst_deg);
   f("midnodes_reconciled", &FemStats::midnodes_reconciled);
   f("midnodes_straightened_at_merge", &FemStats::midnodes_straightened_at_merge);

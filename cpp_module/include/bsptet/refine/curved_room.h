@@ -1,25 +1,35 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// FemBspTet quality stage: room for curved 10-node tets (step 2c of quality_refine.h), with a
-// projection hook and order 2, before the mid-nodes are placed (tet10.h).
+// FemBspTet quality stage: the last polish of the worst tets, keeping room for curved 10-node
+// tets (step 2c of quality_refine.h), with a projection hook and order 2, before the mid-nodes
+// are placed (tet10.h).
 //
 // A curved element here is the tet10 of a linear tet whose boundary edges' mid-nodes lie on the
 // true surface (the hook at the edge's midpoint, with the tags of the edge's boundary faces) and
 // whose other mid-nodes are straight; it is valid when certify_tet10 certifies its Jacobian
 // determinant positive (a tet with no curved edge is valid as its corner tet is positive).
+// Elements left invalid here are mended later by moving mid-nodes (tet10.h, make_second_order).
+// Only when that leaves mid-nodes straightened (off the true surface) does the stage go back to
+// the linear mesh as it was before the tet10 lift and make room first (lift: interior points
+// lifted off the curved faces, reconnections, insertions, down to 1 degree), then polish and lift
+// the tet10 again, keeping whichever tet10 mesh straightened fewer mid-nodes
+// (quality_refine.cpp). Making room always, before the mid-node moves, made worse meshes on CAD
+// parts (t20_data: worst 3.7 degrees against 12.1) and no fewer straightened mid-nodes there; a
+// coarse thin tube (6 segments around) needs it to keep every mid-node on its surface.
 //
 // Contract:
 //  * Takes a valid RefineMesh whose boundary is final (no later step splits a surface edge),
 //    RefineOptions already checked, the stats it adds its counts to, the TargetSizes and the
 //    MeshOptimizer of the stage; all must outlive it.
-//  * lift() does nothing without a hook or with order 1. Else it lifts interior points, changes
-//    connectivity or inserts interior points so that fewer curved elements are invalid, accepting
-//    new tets down to min(10 degrees, the worst they replace), then, for what that leaves, down
-//    to min(1 degree, the worst they replace); polish(below) then raises the tets
-//    below `below` degrees, never lowering the worst tet a change replaces and never making more
-//    curved elements invalid than it removes, so it never lowers the mesh's worst angle.
-//  * After either the linear mesh is valid (mesh_check.h), covers the same region and has the
-//    same boundary: input points, boundary points and the surface never move.
-//  * element_ok needs prepare_check() (lift calls it) after the last change of the boundary;
+//  * lift() and polish(below) do nothing without a hook or with order 1. lift() lifts interior
+//    points, changes connectivity or inserts interior points so that fewer curved elements are
+//    invalid, accepting new tets down to min(10 degrees, the worst they replace), then, for what
+//    that leaves, down to min(1 degree, the worst they replace). polish(below) raises the
+//    tets below `below` degrees, never lowering the worst tet a change replaces and never making
+//    more curved elements invalid than it removes, so it never lowers the mesh's worst angle.
+//    Both set RefineStats::curving_conflicts_left to the invalid curved elements they leave.
+//  * After either the linear mesh is valid (mesh_check.h), covers the same region and has the same
+//    boundary: input points, boundary points and the surface never move.
+//  * element_ok needs prepare_check() (lift and polish call it) after the last change of the boundary;
 //    hook results are cached per boundary edge (boundary points never move).
 //  * Deterministic: tets worst first or in index order, candidates in a fixed order.
 #pragma once
@@ -42,7 +52,7 @@ class CurvedRoom {
       : m_(m), o_(o), st_(st), size_(size), opt_(opt) {}
 
   /// Makes the invalid curved elements valid where it can (see the contract); sets
-  /// RefineStats::curving_conflicts_left, counts curving_lifts.
+  /// RefineStats::curving_conflicts_left.
   void lift();
   /// Flips, moves, collapses and insertions around the tets below `below` degrees (see the
   /// contract); returns the changes made.

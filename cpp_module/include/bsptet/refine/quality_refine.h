@@ -38,9 +38,9 @@
 //     or the worst dihedral reaches `min_dihedral_deg`. Input points never move, except those
 //     flagged in `sliding_points` (with a hook): the ODT sweeps slide them along their face.
 //  2b. separate_face_tags (optional): see the option;
-//  2c. order 2 with a projection hook: room for curved elements (interior points lifted off the
-//     curved faces, or reconnected), then the tets below 15 degrees polished by flips, moves and
-//     collapses that raise the worst tet and make no valid curved element invalid;
+//  2c. order 2 with a projection hook: the tets below 15 degrees polished by flips, moves,
+//     collapses and insertions that raise the worst tet and make no more curved elements invalid
+//     (curved_room.h);
 //  3. order 2: mid-edge nodes (tet10.h), on the true surface through the hook.
 // Deterministic: edges and tets are visited in sorted order; no randomness.
 #pragma once
@@ -155,8 +155,7 @@ struct RefineStats {
   std::int64_t tag_splits = 0;           ///< separate_face_tags: edges split
   std::int64_t tag_conflicts_left = 0;   ///< separate_face_tags: tets still offending (see there)
   std::int64_t midnodes_projected = 0, midnodes_straightened = 0;  ///< order 2 (tet10.h)
-  std::int64_t curving_lifts = 0;           ///< order 2 with a hook: interior points lifted so that
-                                            ///< curved elements stay valid (curved_room.h)
+  std::int64_t curving_lifts = 0;  ///< order 2 with a hook: changes made by CurvedRoom::lift (curved_room.h)
   std::int64_t curving_conflicts_left = 0;  ///< tets whose curved element (interior mid-nodes
                                             ///< straight) was still invalid; the tet10 lift mends them
   /// Order 2 with a hook, the tet10 lift (tet10.h make_second_order): tets made valid by moving
@@ -164,12 +163,10 @@ struct RefineStats {
   /// CAD face or edge, interior points inserted for tets the moves could not mend.
   std::int64_t midnodes_relaxed_tets = 0, midnodes_moved_interior = 0, midnodes_moved_surface = 0;
   std::int64_t lift_insertions = 0;
-  /// Smallest min dihedral angle of the linear tets (degrees) at three points of the stage: when
-  /// the optimization (and separate_face_tags) is done; after the room made for curved elements
-  /// (order 2 with a hook; else the same); and at the end (the output's corner tets). Where the
-  /// worst tet of a mesh comes from: a drop from the first to the second is paid for valid curved
-  /// elements (curved_room.h, CurvedRoom::lift). 180 for a mesh without tets.
-  double worst_deg_optimized = 180, worst_deg_curving_room = 180, worst_deg = 180;
+  /// Smallest min dihedral angle of the linear tets (degrees) when the optimization (and
+  /// separate_face_tags) is done, and at the end (the output's corner tets: after the polish of
+  /// curved_room.h and the points the tet10 lift inserts). 180 for a mesh without tets.
+  double worst_deg_optimized = 180, worst_deg = 180;
   double seconds = 0;
   /// Wall seconds per pass: targets, size, collapse, flip, smooth, radius_edge, insert, sliver,
   /// separate_face_tags, curving, tet10 (order 2: make_second_order) (the passes that ran).
@@ -235,7 +232,6 @@ void for_each_refine_stat(F&& f) {
   f("midnodes_moved_surface", &RefineStats::midnodes_moved_surface);
   f("lift_insertions", &RefineStats::lift_insertions);
   f("worst_deg_optimized", &RefineStats::worst_deg_optimized);
-  f("worst_deg_curving_room", &RefineStats::worst_deg_curving_room);
   f("worst_deg", &RefineStats::worst_deg);
   f("seconds", &RefineStats::seconds);
   f("seconds_by_pass", &RefineStats::seconds_by_pass);
