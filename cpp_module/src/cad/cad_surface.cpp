@@ -178,13 +178,14 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
     for (int f : edge_faces[e]) base = std::min(base, field.face_size(f));
     sizing[e] = sample_edge_sizing(edge, base, field);
     // A vertex asks for the smallest size at the ends of its edges, and for short edges' lengths
-    // (so that faces grade down to a short edge instead of meeting it with long triangles).
+    // (so that faces grade down to a short edge instead of meeting it with long triangles;
+    // below the automatic floor too, SizeField::short_edge_size).
     const double length = sizing[e].length();
     for (int k = 0; k < 2; ++k) {
       const int v = ends[e][k];
       if (v < 0) continue;
       const double at_end = k == 0 ? sizing[e].size.front() : sizing[e].size.back();
-      vertex_size[v] = std::min({vertex_size[v], at_end, field.clamp(length)});
+      vertex_size[v] = std::min({vertex_size[v], at_end, field.short_edge_size(length)});
     }
   }
   for (int e = 0; e < n_edges; ++e) {

@@ -109,8 +109,9 @@ class FaceMesher {
     double s = options_.face_size;
     if (options_.local_curvature_points_per_circle > 0)
       s = std::min(s, local_curvature_size(surface_, uv[0], uv[1], options_.local_curvature_points_per_circle));
+    s = std::max(s, options_.min_size);
     for (const auto& [b, sb] : boundary_sizes_) s = std::min(s, sb + options_.grading * dist(p, b));
-    return std::max(s, options_.min_size);
+    return std::max(s, floor_);
   }
   /// Edge length along the surface (two chords through the (u, v) midpoint), over the local size.
   double edge_ratio(int a, int b) const {
@@ -206,6 +207,7 @@ class FaceMesher {
   std::vector<char> alive_;
   std::vector<std::vector<int>> vt_;
   std::vector<std::pair<Vec3, double>> boundary_sizes_;
+  double floor_ = 0;  // min(options_.min_size, the smallest boundary size)
 };
 
 bool FaceMesher::split(int a, int b, bool untangle) {
@@ -378,7 +380,7 @@ int FaceMesher::split_pass() {
     // A split edge's neighbours may have been split already; the edge is then gone or shorter.
     const auto [t0, t1] = edge_tris(e.first, e.second);
     if (t0 < 0 || t1 < 0) continue;
-    if (!seam_pair(e.first, e.second) && dist(verts_[e.first].xyz, verts_[e.second].xyz) < 2 * options_.min_size) continue;
+    if (!seam_pair(e.first, e.second) && dist(verts_[e.first].xyz, verts_[e.second].xyz) < 2 * floor_) continue;
     done += split(e.first, e.second) ? 1 : 0;
   }
   return done;
@@ -495,7 +497,7 @@ int FaceMesher::untangle_pass() {
         if (collapse(a, b, /*untangle=*/true) || collapse(b, a, /*untangle=*/true)) ++done;
       }
       for (int i = 0; i < 3 && alive_[t]; ++i)
-        if (dist(verts_[x[i]].xyz, verts_[x[(i + 1) % 3]].xyz) > 2 * options_.min_size &&
+        if (dist(verts_[x[i]].xyz, verts_[x[(i + 1) % 3]].xyz) > 2 * floor_ &&
             split(x[i], x[(i + 1) % 3], /*untangle=*/true))
           ++done;
     }
@@ -541,6 +543,8 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
     }
     index_loops.push_back(std::move(ids));
   }
+  floor_ = options_.min_size;
+  for (const auto& bs : boundary_sizes_) floor_ = std::min(floor_, bs.second);
   for (const auto& t : triangulate_polygon(uv, index_loops)) add_tri({t[0], t[1], t[2]});
 
   metric_flip_pass();  // the ear-cut fan into the surface's own shapes,

@@ -61,6 +61,7 @@ SizeField::SizeField(const CadModel& model, const SizeOptions& options) {
   const double diagonal = model.diagonal();
   size_ = options.size > 0 ? options.size : diagonal / 20;
   min_size_ = options.min_size > 0 ? std::min(options.min_size, size_) : size_ / 50;
+  min_size_given_ = options.min_size > 0;
   grading_ = options.grading > 0 ? options.grading : 0.3;
   points_per_circle_ = options.points_per_circle;
   face_size_.assign(static_cast<std::size_t>(model.num_faces()), size_);
@@ -96,6 +97,11 @@ double local_curvature_size(const BRepAdaptor_Surface& surface, double u, double
 }
 
 double SizeField::clamp(double s) const { return std::max(min_size_, std::min(size_, s)); }
+
+double SizeField::short_edge_size(double length) const {
+  if (min_size_given_ || !(length < min_size_)) return clamp(length);
+  return std::max(length, 0.1 * min_size_);
+}
 
 double SizeField::curve_curvature_size(const BRepAdaptor_Curve& curve, double t) const {
   if (points_per_circle_ <= 0) return kInf;

@@ -58,7 +58,10 @@ struct BoundaryNode {
 
 struct FaceMeshOptions {
   double face_size = 1;    ///< the face's size (SizeField::face_size)
-  double min_size = 0;     ///< never split edges shorter than 2 * min_size
+  /// The floor of the face's own sizes (face_size, curvature); sizes graded from boundary nodes
+  /// closer than that (a short CAD edge) go down to the smallest boundary size. Edges shorter
+  /// than twice the smaller of the two are never split.
+  double min_size = 0;
   double grading = 0.3;    ///< growth of the size away from the boundary nodes, per unit length
   /// > 0: the size at a node is also at most the local curvature size there (size_field.h)
   double local_curvature_points_per_circle = 0;
