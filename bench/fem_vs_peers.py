@@ -374,6 +374,42 @@ def boundary_faces(tets):
     return once % 4, once // 4
 
 
+def smallest_wedge(points, tets):
+    """The smallest angle (degrees), inside the solid, between two boundary faces along a common
+    edge. Every tet at that edge has a dihedral angle there no larger, so no mesh of this surface
+    has a larger worst angle; where the CAD's faces meet at that angle, no mesh of the part does.
+    None when no boundary edge has exactly two boundary faces."""
+    local, elements = boundary_faces(tets)
+    if len(local) == 0:
+        return None
+    tri = tets[elements[:, None], TET_FACES[local]]
+    opposite_local = np.array([sorted(set(range(4)) - set(f))[0] for f in TET_FACES])
+    opposite = points[tets[elements, opposite_local[local]]]
+    a, b, c = (points[tri[:, k]] for k in range(3))
+    normal = np.cross(b - a, c - a)
+    normal[np.einsum("ij,ij->i", normal, opposite - a) > 0] *= -1  # outward
+    length = np.linalg.norm(normal, axis=1)
+    normal = normal / np.where(length > 0, length, 1)[:, None]
+    edges, owner, third = [], [], []
+    for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+        edges.append(np.sort(tri[:, [i, j]], axis=1))
+        owner.append(np.arange(len(tri)))
+        third.append(tri[:, k])
+    edges, owner, third = np.vstack(edges), np.concatenate(owner), np.concatenate(third)
+    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    keep = counts[inverse] == 2
+    order = np.argsort(inverse[keep], kind="stable")
+    f, t, e = owner[keep][order], third[keep][order], edges[keep][order]
+    f1, f2, t2, e0 = f[0::2], f[1::2], t[1::2], e[0::2, 0]
+    if len(f1) == 0:
+        return None
+    between = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", normal[f1], normal[f2]), -1, 1)))
+    convex = np.einsum("ij,ij->i", points[t2] - points[e0], normal[f1]) <= 0
+    inside = np.where(convex, 180 - between, 180 + between)
+    return float(inside.min())
+
+
 def boundary_nodes(tets):
     """Node ids on the boundary: corners of boundary faces and, for tet10, their mid-nodes."""
     local, elements = boundary_faces(tets)
@@ -455,7 +491,7 @@ def mesh_measures(path, cad, sample):
             "bad_jacobian": count_nonpositive_jacobians(points, tets),
             "boundary_nodes": int(len(nodes)), "distance_nodes": measured,
             "max_distance": distance, "midnode_offset": midnode_offset(points, tets),
-            "worst": worst}
+            "smallest_wedge": smallest_wedge(points, tets[:, :4]), "worst": worst}
 
 
 # --- the benchmark ------------------------------------------------------------------------------
@@ -796,6 +832,9 @@ def how_measured_section(args):
             "* dihedral angles of each tet's corner tet; per tet the smallest; columns: the "
             "smallest over the mesh (min°), the 1st percentile (1%°), the median, and the share "
             "of tets whose smallest angle is under 10°;",
+            "* the smallest angle between two boundary faces along an edge, inside the solid: "
+            "every tet at that edge has a dihedral angle there no larger, so it bounds the mesh's "
+            "worst angle (where CAD faces meet at a small angle, it bounds every mesher's);",
             "* **bad J**: elements with a Jacobian determinant <= 0 at any of the 4 corners, 6 "
             "mid-nodes and 4 Gauss points (4-point rule) of the quadratic map (tet4: the corner "
             "tet's volume). Orientation: a mesh whose total signed volume is negative (SMESH and "
@@ -830,6 +869,12 @@ def case_section(entry, case, args):
         out += ["Largest mid-node offset from its straight edge's midpoint / edge length "
                 "(0: straight elements): " + ", ".join("%s %.3g" % kv for kv in offsets.items())
                 + ".", ""]
+    wedges = {m: r["smallest_wedge"] for m, r in rows.items()
+              if r.get("ok") and r.get("smallest_wedge") is not None}
+    if wedges:
+        out += ["Smallest angle between two boundary faces along an edge, inside the solid (no tet "
+                "at that edge has a larger worst angle): " +
+                ", ".join("%s %.2f°" % kv for kv in wedges.items()) + ".", ""]
     odd = [m for m, v in offsets.items() if v > 0.5]
     if odd:
         out += ["Warning: a mid-node of %s lies far from its edge: wrong node order?"
@@ -854,6 +899,16 @@ def summary_markdown(results, args):
                 results, args.divisions, args.meshers).items()]
     out += [md_table(["mesher", "D", "meshed", "median min°", "median 1%°", "median median°",
                       "min ≥ 10°", "parts with bad J", "median max dist / h"], rows), ""]
+    narrow = {}
+    for e in results:
+        for c in e["cases"]:
+            ours = c["rows"].get("ours", {})
+            if ours.get("ok") and (ours.get("smallest_wedge") or 180) < 10:
+                narrow[e["part"]] = min(narrow.get(e["part"], 180), ours["smallest_wedge"])
+    if narrow:
+        out += ["Parts where two faces meet inside the solid at under 10° (measured on our surface; "
+                "no mesh of it has its worst angle above that): " +
+                ", ".join("%s (%.2f°)" % kv for kv in sorted(narrow.items())) + ".", ""]
     return out
 
 
