@@ -377,8 +377,8 @@ def boundary_faces(tets):
 def smallest_wedge(points, tets):
     """The smallest angle (degrees), inside the solid, between two boundary faces along a common
     edge. Every tet at that edge has a dihedral angle there no larger, so no mesh of this surface
-    has a larger worst angle; where the CAD's faces meet at that angle, no mesh of the part does.
-    None when no boundary edge has exactly two boundary faces."""
+    has a larger worst angle; where the CAD's faces themselves meet at that angle, no mesh of the
+    part does. None when no boundary edge has exactly two boundary faces."""
     local, elements = boundary_faces(tets)
     if len(local) == 0:
         return None
@@ -834,7 +834,7 @@ def how_measured_section(args):
             "of tets whose smallest angle is under 10°;",
             "* the smallest angle between two boundary faces along an edge, inside the solid: "
             "every tet at that edge has a dihedral angle there no larger, so it bounds the mesh's "
-            "worst angle (where CAD faces meet at a small angle, it bounds every mesher's);",
+            "worst angle (where the CAD faces themselves meet at that angle, every mesher's);",
             "* **bad J**: elements with a Jacobian determinant <= 0 at any of the 4 corners, 6 "
             "mid-nodes and 4 Gauss points (4-point rule) of the quadratic map (tet4: the corner "
             "tet's volume). Orientation: a mesh whose total signed volume is negative (SMESH and "
@@ -906,8 +906,9 @@ def summary_markdown(results, args):
             if ours.get("ok") and (ours.get("smallest_wedge") or 180) < 10:
                 narrow[e["part"]] = min(narrow.get(e["part"], 180), ours["smallest_wedge"])
     if narrow:
-        out += ["Parts where two faces meet inside the solid at under 10° (measured on our surface; "
-                "no mesh of it has its worst angle above that): " +
+        out += ["Parts where two of our boundary triangles meet inside the solid at under 10° "
+                "(every tet at that edge has its worst angle below that; the CAD faces there may "
+                "meet at a wider angle than the chords do): " +
                 ", ".join("%s (%.2f°)" % kv for kv in sorted(narrow.items())) + ".", ""]
     return out
 
