@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -18,6 +19,7 @@
 #include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
+#include <BRepPrimAPI_MakeWedge.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -52,9 +54,10 @@ Vec3 cross(const Vec3& a, const Vec3& b) { return {a.y * b.z - a.z * b.y, a.z * 
 double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 /// The invariants every meshed model must meet; returns the surface for further checks.
-cad::CadSurface mesh_and_check(const cad::CadModel& model, double size = 0) {
+cad::CadSurface mesh_and_check(const cad::CadModel& model, double size = 0, double min_size = 0) {
   cad::CadSurfaceOptions options;
   options.size.size = size;
+  options.size.min_size = min_size;
   cad::CadSurfaceStats stats;
   const cad::CadSurface s = cad::mesh_cad_surface(model, options, &stats);
   EXPECT_EQ(static_cast<int>(s.solid_tri.size()), model.num_solids());
@@ -133,7 +136,37 @@ cad::CadModel rotated(const TopoDS_Shape& shape, const std::string& name) {
   return cad::make_cad_model(BRepBuilderAPI_Transform(shape, turn, true).Shape(), name);
 }
 
+// The shortest surface edge at a CAD vertex node, leaving out edges between two CAD vertices (a
+// CAD edge meshed as one segment).
+double shortest_edge_leaving_vertices(const cad::CadSurface& s) {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const auto& tri : s.solid_tri)
+    for (std::size_t k = 0; k < tri.size(); k += 3)
+      for (int i = 0; i < 3; ++i) {
+        const Index a = tri[k + i], b = tri[k + (i + 1) % 3];
+        const bool at_a = s.node_dim[static_cast<std::size_t>(a)] == 0, at_b = s.node_dim[static_cast<std::size_t>(b)] == 0;
+        if (at_a == at_b) continue;
+        const Vec3 d = sub(node(s, a), node(s, b));
+        shortest = std::min(shortest, std::sqrt(dot(d, d)));
+      }
+  return shortest;
+}
+
 }  // namespace
+
+// A wedge whose top edges (0.005 long) are shorter than the automatic floor h / 50 (about
+// 0.017 at h = diagonal / 20): the edges leaving their ends start at about their length and grade
+// up, instead of meeting them at the floor's size (needles). With the floor given as min_size,
+// nothing goes below it.
+TEST(CadSurface, ShortEdgesGradeTheSizesDownToThem) {
+  const cad::CadModel model = rotated(BRepPrimAPI_MakeWedge(10, 10, 10, 0.005).Shape(), "wedge");
+  const double floor = model.diagonal() / 20 / 50;
+  ASSERT_LT(0.005, floor);
+  const cad::CadSurface automatic = mesh_and_check(model);
+  const cad::CadSurface floored = mesh_and_check(model, 0, floor);
+  EXPECT_LT(shortest_edge_leaving_vertices(automatic), 0.5 * floor);
+  EXPECT_GT(shortest_edge_leaving_vertices(floored), 0.5 * floor);
+}
 
 TEST(CadSurface, BracketHolesAndFilletAreUniform) {
   const cad::CadModel model = cad::read_cad_file(data("cad/bracket.step"));
