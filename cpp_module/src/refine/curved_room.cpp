@@ -299,7 +299,7 @@ std::int64_t CurvedRoom::polish(double below) {
     return true;
   };
   std::int64_t changes = 0;
-  double worst = opt_.worst_quality();
+  double worst = m_.worst_tet_quality();
   for (int round = 0, idle = 0; round < kPolishMaxRounds && idle < kPolishPatienceRounds; ++round) {
     poll_refine(o_, "optimizing curved elements", 0.97);
     std::int64_t now = 0;
@@ -355,7 +355,7 @@ std::int64_t CurvedRoom::polish(double below) {
     }
     changes += now;
     if (now == 0) break;
-    const double now_worst = opt_.worst_quality();
+    const double now_worst = m_.worst_tet_quality();
     idle = now_worst > worst ? 0 : idle + 1;
     worst = now_worst;
   }

@@ -62,13 +62,6 @@ void poll_refine(const RefineOptions& o, const std::string& stage, double fracti
   if (o.progress) o.progress(stage, fraction);
 }
 
-double MeshOptimizer::worst_quality() const {
-  double w = 180;
-  for (Index t = 0; t < m_.num_tet_slots(); ++t)
-    if (m_.tet_alive(t)) w = std::min(w, m_.tet_quality(t));
-  return w;
-}
-
 std::vector<Index> MeshOptimizer::tets_below(double q) const {
   std::vector<std::pair<double, Index>> bad;
   for (Index t = 0; t < m_.num_tet_slots(); ++t)
@@ -145,7 +138,7 @@ std::int64_t MeshOptimizer::collapse_pass() {
   std::sort(todo.begin(), todo.end());
   // New tets stay at or above min(max(collapse_min_dihedral_deg, the mesh's worst tet), the
   // worst tet around the point): the mesh's worst dihedral angle never drops.
-  const double floor = std::max(o_.collapse_min_dihedral_deg, worst_quality());
+  const double floor = std::max(o_.collapse_min_dihedral_deg, m_.worst_tet_quality());
   std::int64_t n = 0;
   for (const auto& [r, u, v] : todo) {
     if (!m_.point_alive(u) || !m_.point_alive(v)) continue;
@@ -521,7 +514,7 @@ std::int64_t MeshOptimizer::sliver_pass(double below) {
   // No split may make a tet worse than the mesh's worst: unchecked splits here made slivers
   // that no later pass removed (hinge at h = diagonal / 20: the last optimization's sliver
   // splits took the worst angle from 4.4 to 1.3 degrees, and it ended at 2.3).
-  const double keep = curved_tet10() ? 0.0 : worst_quality();
+  const double keep = curved_tet10() ? 0.0 : m_.worst_tet_quality();
   for (Index t : tets_below(below)) {
     if (!m_.tet_alive(t)) continue;
     const auto q = m_.tet(t);
@@ -612,7 +605,7 @@ void MeshOptimizer::optimize(int rounds, Index tets_after_size) {
       slivers_before = slivers < slivers_before ? slivers : 0;
     }
     ++st_.optimize_rounds;
-    if (changes == 0 || (o_.min_dihedral_deg > 0 && worst_quality() >= o_.min_dihedral_deg)) break;
+    if (changes == 0 || (o_.min_dihedral_deg > 0 && m_.worst_tet_quality() >= o_.min_dihedral_deg)) break;
   }
 }
 

@@ -82,9 +82,9 @@ class Refiner {
       for (int round = 0; round < 3 && opt_.smooth_pass(30.0) > 0; ++round) {
       }
     }
-    st_.worst_deg_optimized = opt_.worst_quality();
+    st_.worst_deg_optimized = m_.worst_tet_quality();
     timed_pass(st_, "curving", [&] { return curved_.polish(kPolishCurvedBelowDeg); });
-    st_.worst_deg = opt_.worst_quality();
+    st_.worst_deg = m_.worst_tet_quality();
     // Counted last (the smoothing after separate_face_tags and the lifts move points too) against
     // the asked sizes: the targets raised around edges that could not be split do not count.
     size_.compute(false);
@@ -98,7 +98,7 @@ class Refiner {
     size_.compute(false);
     timed_pass(st_, "curving", [&] { curved_.lift(); return 0; });
     timed_pass(st_, "curving", [&] { return curved_.polish(kPolishCurvedBelowDeg); });
-    st_.worst_deg = opt_.worst_quality();
+    st_.worst_deg = m_.worst_tet_quality();
   }
 
  private:
@@ -226,19 +226,22 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
   if (options.order == 2) {
     // The tet10 lift; when it straightened mid-nodes, once more from the linear mesh as it was,
     // with room made for the curved elements first (curved_room.h), keeping the better one.
+    auto lift = [&](RefineMesh& mesh, SecondOrderStats* so_out, RefineStats& timed) {
+      const auto lift_start = std::chrono::steady_clock::now();
+      TetMesh lifted = make_second_order(mesh, options.projection, so_out);
+      timed.seconds_by_pass["tet10"] +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - lift_start).count();
+      return lifted;
+    };
     std::unique_ptr<RefineMesh> before;
     if (options.projection) before = std::make_unique<RefineMesh>(*m);
     SecondOrderStats so;
-    const auto lift_start = std::chrono::steady_clock::now();
-    out = make_second_order(*m, options.projection, &so);
-    st.seconds_by_pass["tet10"] += std::chrono::duration<double>(std::chrono::steady_clock::now() - lift_start).count();
+    out = lift(*m, &so, st);
     if (so.straightened > 0 && before) {
       RefineStats st2 = st;
       Refiner(*before, options, st2).make_room_for_curving();
       SecondOrderStats so2;
-      const auto again_start = std::chrono::steady_clock::now();
-      TetMesh out2 = make_second_order(*before, options.projection, &so2);
-      st2.seconds_by_pass["tet10"] += std::chrono::duration<double>(std::chrono::steady_clock::now() - again_start).count();
+      TetMesh out2 = lift(*before, &so2, st2);
       if (so2.straightened < so.straightened) {
         m = std::move(before);
         out = std::move(out2);
@@ -254,17 +257,15 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
     st.midnodes_moved_interior = so.interior_moved;
     st.midnodes_moved_surface = so.surface_moved;
     st.lift_insertions = so.points_inserted;
-    if (so.points_inserted > 0) {  // its points made new tets: the end's worst is theirs too
-      st.worst_deg = 180;
-      for (Index t = 0; t < m->num_tet_slots(); ++t)
-        if (m->tet_alive(t)) st.worst_deg = std::min(st.worst_deg, m->tet_quality(t));
-    }
-  } else {
-    out = m->to_tet_mesh();
+    if (so.points_inserted > 0) st.worst_deg = m->worst_tet_quality();  // its points made new tets
   }
+  // The linear mesh once: the order-1 result, the corner count, and the numbering of the result
+  // (make_second_order's corners too) for the boundary.
+  std::vector<Index> old_to_new;
+  TetMesh linear = m->to_tet_mesh(&old_to_new);
+  st.points = linear.num_points();
+  if (options.order != 2) out = std::move(linear);
   if (boundary) {
-    std::vector<Index> old_to_new;
-    m->to_tet_mesh(&old_to_new);  // the numbering of the result (make_second_order's corners too)
     *boundary = SurfaceMesh{};
     for (const auto& [face, parent] : m->boundary_faces()) {
       for (Index v : face) boundary->tri.push_back(old_to_new[static_cast<std::size_t>(v)]);
@@ -273,7 +274,6 @@ TetMesh refine_quality(const SurfaceMesh& surface, const TetMesh& mesh, const Re
   }
   st.tets = out.num_tets();
   st.nodes = out.num_points();
-  st.points = m->to_tet_mesh().num_points();
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = st;
   return out;

@@ -263,6 +263,13 @@ bool RefineMesh::positive_with(const std::array<Index, 4>& t, Index moved, const
   return orient3d(q[0], q[1], q[2], q[3]) == Sign::kPositive;
 }
 
+double RefineMesh::worst_tet_quality() const {
+  double w = 180;
+  for (Index t = 0; t < num_tet_slots(); ++t)
+    if (tet_alive(t)) w = std::min(w, tet_quality(t));
+  return w;
+}
+
 double RefineMesh::quality_of(const std::array<Index, 4>& t) const {
   return tet_min_dihedral_deg(point(t[0]), point(t[1]), point(t[2]), point(t[3]));
 }

@@ -64,7 +64,7 @@ TEST(FaceFrame, NormalTowardsTheFourthCornerAndRegularApex) {
 
 TEST(MeshOptimizer, WorstQualityAndTetsBelowAgree) {
   Refined box(0.15);
-  const double worst = box.opt->worst_quality();
+  const double worst = box.m->worst_tet_quality();
   EXPECT_EQ(worst, box.worst());
   const std::vector<Index> below = box.opt->tets_below(30.0);
   EXPECT_EQ(below.size(), box.opt->count_below(30.0));

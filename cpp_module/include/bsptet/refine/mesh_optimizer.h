@@ -151,8 +151,6 @@ class MeshOptimizer {
   bool insert_for(Index t);
 
   // ---- Queries ----
-  /// Smallest angle of the live tets (180 without tets).
-  double worst_quality() const;
   /// The live tets below q degrees, worst first (ties by index).
   std::vector<Index> tets_below(double q) const;
   std::size_t count_below(double q) const;

@@ -110,6 +110,8 @@ class RefineMesh {
   const std::array<Index, 4>& tet(Index t) const { return tets_[static_cast<std::size_t>(t)]; }
   /// Min dihedral angle of a live tet, degrees (cached).
   double tet_quality(Index t) const { return quality_[static_cast<std::size_t>(t)]; }
+  /// Smallest min dihedral angle of the live tets, degrees (180 without tets).
+  double worst_tet_quality() const;
   Index num_alive_tets() const { return alive_tets_; }
   /// Change stamps: clock() grows with every change (a tet added or removed, a point moved); a
   /// point's stamp is the clock of the last change to a tet containing it (added, removed or
