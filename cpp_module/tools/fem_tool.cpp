@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // bsptet_fem: a CAD file to a tetrahedral FEM mesh (fem/fem_mesh.h), with its figures.
 //
-//   bsptet_fem PART.step [--size H] [--min-size HMIN] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]
+//   bsptet_fem PART.step [--size H] [--min-size HMIN] [--order 1|2] [--optimize-rounds N] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]
 //
 // Prints the sizes, counts, dihedral angles (smallest, median of each tet's smallest, share of
 // tets under 10 degrees; the refinement's worst at its stages, RefineStats::worst_deg_*) and
-// seconds per stage. --vtu writes the mesh (tets and CAD face triangles, fem_io.h); --off writes
+// seconds per stage. --optimize-rounds: FemOptions::optimize_rounds. --vtu writes the mesh (tets and CAD face triangles, fem_io.h); --off writes
 // the CAD face triangles' corners as one surface; --distance also measures how far the nodes of
 // the face triangles lie from their CAD faces (slow: one OpenCASCADE extrema search per node and
 // face). --workers N: solids meshed at the same time (FemOptions::workers; default every core).
@@ -23,7 +23,7 @@
 
 int main(int argc, char** argv) {
   using namespace bsptet;
-  const char* usage = "usage: bsptet_fem PART [--size H] [--min-size HMIN] [--order 1|2] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]\n";
+  const char* usage = "usage: bsptet_fem PART [--size H] [--min-size HMIN] [--order 1|2] [--optimize-rounds N] [--workers N] [--vtu OUT.vtu] [--off OUT.off] [--distance]\n";
   if (argc < 2) {
     std::fprintf(stderr, "%s", usage);
     return 2;
@@ -38,6 +38,8 @@ int main(int argc, char** argv) {
       options.min_size = std::atof(argv[++i]);
     } else if (!std::strcmp(argv[i], "--order") && i + 1 < argc) {
       options.order = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--optimize-rounds") && i + 1 < argc) {
+      options.optimize_rounds = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--workers") && i + 1 < argc) {
       options.workers = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--off") && i + 1 < argc) {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -239,17 +241,15 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
   if (!m_.point_alive(v)) return false;
   const bool slides = m_.slides(v);
   if (!slides && m_.support(v).kind != Support::kInterior) return false;
+  // A move that failed fails again while no tet around v changed (v's stamp, RefineMesh::clock):
+  // the ODT point, the centroids and every check depend on those tets only.
+  if (odt_failed_.size() < static_cast<std::size_t>(m_.num_points()))
+    odt_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
+  std::uint64_t& failed = odt_failed_[static_cast<std::size_t>(v)];
+  if (failed != 0 && m_.point_stamp(v) <= failed) return false;
+  failed = std::max<std::uint64_t>(m_.clock(), 1);  // a move touches v's tets, which stamps v anew
   const std::vector<Index> ball = m_.tets_around_point(v);
   if (ball.empty()) return false;
-  if (slides) {
-    if (slide_failed_.size() < static_cast<std::size_t>(m_.num_points()))
-      slide_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
-    std::uint64_t& failed = slide_failed_[static_cast<std::size_t>(v)];
-    std::uint64_t stamp = 0;
-    for (Index t : ball) stamp = std::max(stamp, m_.tet_stamp(t));
-    if (failed != 0 && stamp <= failed) return false;
-    failed = std::max<std::uint64_t>(m_.clock(), 1);  // cleared below when it moves
-  }
   double wsum = 0, mean_before = 0, worst_before = 180;
   Vec3 x{0, 0, 0};
   bool ok = true;
@@ -293,7 +293,6 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
       if (slides ? m_.slide_point_if(v, q, accept) : m_.relocate_point_if(v, q, accept)) {
         for (Index t : ball)
           for (Index w : m_.tet(t)) (*moved_near)[static_cast<std::size_t>(w)] = 1;
-        if (slides) slide_failed_[static_cast<std::size_t>(v)] = 0;
         return true;
       }
     }
@@ -347,6 +346,12 @@ std::int64_t MeshOptimizer::smooth_pass(double below) {
 // worst tet (lifting a flat tet).
 bool MeshOptimizer::smooth_point(Index v) {
   if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
+  // As odt_move: a point that could not move stays put until a tet around it changes.
+  if (smooth_failed_.size() < static_cast<std::size_t>(m_.num_points()))
+    smooth_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
+  std::uint64_t& failed = smooth_failed_[static_cast<std::size_t>(v)];
+  if (failed != 0 && m_.point_stamp(v) <= failed) return false;
+  failed = std::max<std::uint64_t>(m_.clock(), 1);
   const std::vector<Index> ball = m_.tets_around_point(v);
   Vec3 c{0, 0, 0};
   int k = 0;
@@ -605,6 +610,12 @@ void MeshOptimizer::optimize(int rounds, Index tets_after_size) {
       slivers_before = slivers < slivers_before ? slivers : 0;
     }
     ++st_.optimize_rounds;
+    if (getenv("ROUNDDBG")) {
+      std::vector<double> qs; for (Index t = 0; t < m_.num_tet_slots(); ++t) if (m_.tet_alive(t)) qs.push_back(m_.tet_quality(t));
+      std::sort(qs.begin(), qs.end());
+      static auto t0 = std::chrono::steady_clock::now();
+      fprintf(stderr, "round %d changes %lld t %.2f median %.3f worst %.2f tets %zu\n", round, (long long)changes, std::chrono::duration<double>(std::chrono::steady_clock::now()-t0).count(), qs[qs.size()/2], qs[0], qs.size());
+    }
     if (changes == 0 || (o_.min_dihedral_deg > 0 && m_.worst_tet_quality() >= o_.min_dihedral_deg)) break;
   }
 }

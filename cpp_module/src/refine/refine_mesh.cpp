@@ -305,7 +305,7 @@ EdgeKind RefineMesh::edge_kind(Index u, Index v, Index* tri_a, Index* tri_b) {
   std::vector<std::pair<FaceKey, Index>> found;
   for (Index t : tets_around_edge(u, v))
     for (Index x : tet(t)) {
-      if (x == u || x == v) continue;
+      if (x == u || x == v || support(x).kind == Support::kInterior) continue;
       auto it = boundary_.find(face_key(u, v, x));
       if (it == boundary_.end()) continue;
       if (std::find_if(found.begin(), found.end(), [&](const auto& f) { return f.first == it->first; }) == found.end())
@@ -382,7 +382,7 @@ std::vector<Index> RefineMesh::boundary_neighbours(Index v) {
     const auto& q = tet(t);
     for (int k = 0; k < 4; ++k) {
       const Index a = q[(k + 1) % 4], b = q[(k + 2) % 4], c = q[(k + 3) % 4];
-      if (q[k] == v || !boundary_.count(face_key(a, b, c))) continue;
+      if (q[k] == v || !is_boundary_face(a, b, c)) continue;
       for (Index w : {a, b, c})
         if (w != v) out.push_back(w);
     }
@@ -432,7 +432,7 @@ bool RefineMesh::slide_point_if(Index v, const Vec3& target,
       for (int k = 0; k < 4; ++k) {
         if (t[k] == v) continue;
         const Index a = t[(k + 1) % 4], b = t[(k + 2) % 4], c = t[(k + 3) % 4];
-        if (!boundary_.count(face_key(a, b, c))) continue;
+        if (!is_boundary_face(a, b, c)) continue;
         const auto at = [&](Index w) { return w == v ? p : point(w); };
         worst_before = std::min(worst_before, triangle_min_angle_deg(point(a), point(b), point(c)));
         worst_after = std::min(worst_after, triangle_min_angle_deg(at(a), at(b), at(c)));
@@ -453,7 +453,7 @@ bool RefineMesh::slide_point_if(Index v, const Vec3& target,
       if (q[k] == v) continue;
       static const int outward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // types.h
       const Index a = q[outward[k][0]], b = q[outward[k][1]], c = q[outward[k][2]];
-      if (!boundary_.count(face_key(a, b, c))) continue;
+      if (!is_boundary_face(a, b, c)) continue;
       const Vec3 &A = point(a), &B = point(b), &C = point(c);
       const double ux = B.x - A.x, uy = B.y - A.y, uz = B.z - A.z, wx = C.x - A.x, wy = C.y - A.y, wz = C.z - A.z;
       n.x += uy * wz - uz * wy, n.y += uz * wx - ux * wz, n.z += ux * wy - uy * wx;
@@ -698,7 +698,7 @@ bool RefineMesh::flip23(Index t, int opposite_vertex, const TetsAccept& accept) 
   const auto& q = tet(t);
   const Index a = q[opposite_vertex];
   const Index x = q[kOppositeFace[opposite_vertex][0]], y = q[kOppositeFace[opposite_vertex][1]], z = q[kOppositeFace[opposite_vertex][2]];
-  if (boundary_.count(face_key(x, y, z))) return false;
+  if (is_boundary_face(x, y, z)) return false;
   Index other = -1, b = -1;
   for (Index s : tets_around_point(x)) {
     if (s == t) continue;
@@ -785,7 +785,7 @@ bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAc
     chain.push_back(it->second);
   }
   // (u, v, a) and (u, v, b) must be the boundary faces, and the new edge (a, b) must not exist.
-  const auto is_boundary = [&](Index a, Index b, Index c) { return boundary_.count(face_key(a, b, c)) != 0; };
+  const auto is_boundary = [&](Index a, Index b, Index c) { return is_boundary_face(a, b, c); };
   if (!is_boundary(u, v, chain.front()) || !is_boundary(u, v, chain.back())) return false;
   if (edge_exists(chain.front(), chain.back())) return false;
   if (only_if_not_delaunay) {
@@ -875,7 +875,7 @@ Index RefineMesh::neighbour(Index t, int k) {
   if (cached == -1 || (cached >= 0 && tet_alive(cached))) return cached;
   const auto q = tet(t);
   const Index a = q[kOppositeFace[k][0]], b = q[kOppositeFace[k][1]], c = q[kOppositeFace[k][2]];
-  if (boundary_.count(face_key(a, b, c))) return cached = -1;
+  if (is_boundary_face(a, b, c)) return cached = -1;
   for (Index n : tets_around_point(a)) {
     if (n == t) continue;
     const auto& r = tet(n);

@@ -138,11 +138,12 @@ class MeshOptimizer {
   // ---- Single operations ----
   /// odt_smooth_pass's move of interior point v (the ODT point, else its neighbours' centroid)
   /// or of sliding surface point v (its boundary neighbours' centroid, else the ODT point, each
-  /// put back on its face; not tried again until a tet around it changes after it failed); when
-  /// it moves, sets moved_near[w] for every corner w of its tets. True when v moved.
+  /// put back on its face); a point whose move failed is not tried again until a tet around it
+  /// changes (RefineMesh::point_stamp); when it moves, sets moved_near[w] for every corner w of
+  /// its tets. True when v moved.
   bool odt_move(Index v, std::vector<char>* moved_near);
   /// Moves interior point v to the first position that raises the worst tet around it; true when
-  /// it moved.
+  /// it moved. Not tried again after a failure until a tet around v changes.
   bool smooth_point(Index v);
   /// Steepest ascent of the worst angle around interior point v (steps from 0.1 * mean_edge);
   /// with `keep`, every step must also pass it. True when v moved.
@@ -168,7 +169,8 @@ class MeshOptimizer {
   RefineStats& st_;
   TargetSizes& size_;
   FailureMemory flip_failed_, insert_failed_;
-  std::vector<std::uint64_t> slide_failed_;  // per point: the clock when its slide last failed
+  std::vector<std::uint64_t> odt_failed_;     // per point: the clock when its odt_move last failed
+  std::vector<std::uint64_t> smooth_failed_;  // per point: the clock when its smooth_point last failed
   std::vector<Index> shell_;  // flip_pass: scratch for a shell
 };
 

@@ -118,6 +118,7 @@ class RefineMesh {
   /// reshaped), tet_stamp(t) the largest of its corners'. When tet_stamp(t) has not grown since
   /// an operation on t failed, the tets around t's corners are the same and in the same place.
   std::uint64_t clock() const { return clock_; }
+  std::uint64_t point_stamp(Index v) const { return stamp_[static_cast<std::size_t>(v)]; }
   std::uint64_t tet_stamp(Index t) const;
   /// Live tets incident to point v, in increasing id order (valid until the next change).
   const std::vector<Index>& tets_around_point(Index v);
@@ -271,6 +272,14 @@ class RefineMesh {
     std::size_t operator()(const FaceKey& k) const;
   };
   static FaceKey face_key(Index a, Index b, Index c);
+  /// True when (a, b, c) is a boundary face. A face with an interior corner never is (supports
+  /// are exact), which spares the hash lookup for most faces.
+  bool is_boundary_face(Index a, Index b, Index c) const {
+    if (support(a).kind == Support::kInterior || support(b).kind == Support::kInterior ||
+        support(c).kind == Support::kInterior)
+      return false;
+    return boundary_.count(face_key(a, b, c)) != 0;
+  }
 
   Index add_tet(const std::array<Index, 4>& t);
   void kill_tet(Index t);
