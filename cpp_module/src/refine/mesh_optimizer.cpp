@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -610,12 +608,6 @@ void MeshOptimizer::optimize(int rounds, Index tets_after_size) {
       slivers_before = slivers < slivers_before ? slivers : 0;
     }
     ++st_.optimize_rounds;
-    if (getenv("ROUNDDBG")) {
-      std::vector<double> qs; for (Index t = 0; t < m_.num_tet_slots(); ++t) if (m_.tet_alive(t)) qs.push_back(m_.tet_quality(t));
-      std::sort(qs.begin(), qs.end());
-      static auto t0 = std::chrono::steady_clock::now();
-      fprintf(stderr, "round %d changes %lld t %.2f median %.3f worst %.2f tets %zu\n", round, (long long)changes, std::chrono::duration<double>(std::chrono::steady_clock::now()-t0).count(), qs[qs.size()/2], qs[0], qs.size());
-    }
     if (changes == 0 || (o_.min_dihedral_deg > 0 && m_.worst_tet_quality() >= o_.min_dihedral_deg)) break;
   }
 }
