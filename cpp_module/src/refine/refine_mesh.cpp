@@ -785,8 +785,7 @@ bool RefineMesh::flip_boundary_edge(Index u, Index v, int max_ring, const TetsAc
     chain.push_back(it->second);
   }
   // (u, v, a) and (u, v, b) must be the boundary faces, and the new edge (a, b) must not exist.
-  const auto is_boundary = [&](Index a, Index b, Index c) { return is_boundary_face(a, b, c); };
-  if (!is_boundary(u, v, chain.front()) || !is_boundary(u, v, chain.back())) return false;
+  if (!is_boundary_face(u, v, chain.front()) || !is_boundary_face(u, v, chain.back())) return false;
   if (edge_exists(chain.front(), chain.back())) return false;
   if (only_if_not_delaunay) {
     // The angles at a and b facing (u, v), in doubles (a choice, not a validity decision).
