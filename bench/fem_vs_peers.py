@@ -1074,16 +1074,20 @@ def parse_args(argv):
     return args
 
 
-def without_workdir(argv):
-    """The command line as the report gives it: --workdir names a folder of this machine and
-    changes no figure."""
+# Options that only name files or folders of this machine: the report's command line leaves them
+# out (they change no figure).
+MACHINE_PATH_OPTIONS = ("--workdir", "--json", "--out-dir")
+
+
+def report_argv(argv):
+    """The command line as the report gives it, without MACHINE_PATH_OPTIONS and their values."""
     out, skip = [], False
     for a in argv:
         if skip:
             skip = False
-        elif a == "--workdir":
+        elif a in MACHINE_PATH_OPTIONS:
             skip = True
-        elif not a.startswith("--workdir="):
+        elif not any(a.startswith(o + "=") for o in MACHINE_PATH_OPTIONS):
             out.append(a)
     return out
 
@@ -1092,7 +1096,7 @@ def main(argv):
     if argv[:1] == ["--worker"]:
         return run_worker(argv[1:])
     args = parse_args(argv)
-    command = "bench/fem_vs_peers.py " + " ".join(shlex.quote(a) for a in without_workdir(argv))
+    command = "bench/fem_vs_peers.py " + " ".join(shlex.quote(a) for a in report_argv(argv))
     started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     t0 = time.perf_counter()
     workdir = args.workdir or tempfile.mkdtemp(prefix="fem-vs-peers-")

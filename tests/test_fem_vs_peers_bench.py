@@ -36,6 +36,12 @@ def straight_tet10(corners):
     return np.vstack([corners, mids]), np.arange(10)[None, :]
 
 
+def test_the_report_command_names_no_file_of_this_machine():
+    argv = ["--order", "2", "--json", "runs/figures.json", "--workdir=runs", "--out-dir", "out",
+            "--timeout", "300", "part.step"]
+    assert B.report_argv(argv) == ["--order", "2", "--timeout", "300", "part.step"]
+
+
 def test_regular_tet_dihedrals_are_all_70_53():
     assert B.corner_volumes6(REGULAR, np.array([[0, 1, 2, 3]]))[0] > 0
     angles = B.dihedral_angles(REGULAR, np.array([[0, 1, 2, 3]]))
