@@ -239,13 +239,8 @@ bool MeshOptimizer::odt_move(Index v, std::vector<char>* moved_near) {
   if (!m_.point_alive(v)) return false;
   const bool slides = m_.slides(v);
   if (!slides && m_.support(v).kind != Support::kInterior) return false;
-  // A move that failed fails again while no tet around v changed (v's stamp, RefineMesh::clock):
-  // the ODT point, the centroids and every check depend on those tets only.
-  if (odt_failed_.size() < static_cast<std::size_t>(m_.num_points()))
-    odt_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
-  std::uint64_t& failed = odt_failed_[static_cast<std::size_t>(v)];
-  if (failed != 0 && m_.point_stamp(v) <= failed) return false;
-  failed = std::max<std::uint64_t>(m_.clock(), 1);  // a move touches v's tets, which stamps v anew
+  // The ODT point, the centroids and every check depend on the tets around v only.
+  if (odt_failed_.skip(m_, v)) return false;
   const std::vector<Index> ball = m_.tets_around_point(v);
   if (ball.empty()) return false;
   double wsum = 0, mean_before = 0, worst_before = 180;
@@ -344,12 +339,7 @@ std::int64_t MeshOptimizer::smooth_pass(double below) {
 // worst tet (lifting a flat tet).
 bool MeshOptimizer::smooth_point(Index v) {
   if (!m_.point_alive(v) || m_.support(v).kind != Support::kInterior) return false;
-  // As odt_move: a point that could not move stays put until a tet around it changes.
-  if (smooth_failed_.size() < static_cast<std::size_t>(m_.num_points()))
-    smooth_failed_.resize(static_cast<std::size_t>(m_.num_points()), 0);
-  std::uint64_t& failed = smooth_failed_[static_cast<std::size_t>(v)];
-  if (failed != 0 && m_.point_stamp(v) <= failed) return false;
-  failed = std::max<std::uint64_t>(m_.clock(), 1);
+  if (smooth_failed_.skip(m_, v)) return false;  // its candidates depend on the tets around v only
   const std::vector<Index> ball = m_.tets_around_point(v);
   Vec3 c{0, 0, 0};
   int k = 0;

@@ -98,6 +98,24 @@ class FailureMemory {
   std::vector<std::uint64_t> at_;
 };
 
+/// The same for moves of a point: a point whose move failed is not tried again until a tet around
+/// it changes (RefineMesh::point_stamp), exact when the move depends on those tets alone.
+class PointFailureMemory {
+ public:
+  /// True when v's last try failed and no tet around v changed since; otherwise notes a try of v
+  /// starting now (a move touches v's tets, which stamps v anew, so only a failure keeps it).
+  bool skip(const RefineMesh& m, Index v) {
+    const auto i = static_cast<std::size_t>(v);
+    if (tried_at_.size() <= i) tried_at_.resize(std::max<std::size_t>(i + 1, 2 * tried_at_.size()), 0);
+    if (tried_at_[i] != 0 && m.point_stamp(v) <= tried_at_[i]) return true;
+    tried_at_[i] = std::max<std::uint64_t>(m.clock(), 1);
+    return false;
+  }
+
+ private:
+  std::vector<std::uint64_t> tried_at_;
+};
+
 class MeshOptimizer {
  public:
   /// Edge removals (RefineMesh::remove_edge) look at shells of at most this many tets.
@@ -169,8 +187,7 @@ class MeshOptimizer {
   RefineStats& st_;
   TargetSizes& size_;
   FailureMemory flip_failed_, insert_failed_;
-  std::vector<std::uint64_t> odt_failed_;     // per point: the clock when its odt_move last failed
-  std::vector<std::uint64_t> smooth_failed_;  // per point: the clock when its smooth_point last failed
+  PointFailureMemory odt_failed_, smooth_failed_;
   std::vector<Index> shell_;  // flip_pass: scratch for a shell
 };
 
