@@ -221,18 +221,16 @@ void CurvedRoom::lift_rounds() {
 
 // Once the surface is final: the tags of each boundary edge's faces, for the projection hook.
 void CurvedRoom::prepare_check() {
-  edge_tags_.clear();
-  projected_.clear();
+  edge_tags_.release();
+  projected_.release();
   for (const auto& [face, parent] : m_.boundary_faces())
     for (int k = 0; k < 3; ++k) {
-      const Index a = face[k], b = face[(k + 1) % 3];
-      const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+      const std::uint64_t key = edge_key(face[k], face[(k + 1) % 3]);
       const std::int32_t tag = m_.tag_of(parent);
-      auto it = edge_tags_.find(key);
-      if (it == edge_tags_.end())
-        edge_tags_.emplace(key, std::array<std::int32_t, 2>{tag, tag});
+      if (auto* tags = edge_tags_.find(key))
+        (*tags)[1] = tag;
       else
-        it->second[1] = tag;
+        edge_tags_[key] = {tag, tag};
     }
 }
 
@@ -247,18 +245,16 @@ bool CurvedRoom::element_ok(const std::array<Index, 4>& q, const std::array<Vec3
   for (int e = 0; e < 6; ++e) {
     const int i = kEdge[e][0], j = kEdge[e][1];
     Vec3 mid{0.5 * (P[i].x + P[j].x), 0.5 * (P[i].y + P[j].y), 0.5 * (P[i].z + P[j].z)};
-    const std::array<Index, 2> key{std::min(q[i], q[j]), std::max(q[i], q[j])};
-    auto tg = edge_tags_.find(key);
-    if (tg != edge_tags_.end()) {
-      auto pr = projected_.find(key);  // boundary points never move: a safe cache
-      if (pr == projected_.end()) {
-        const auto tt = tg->second;
-        Vec3 y = o_.projection(mid, tt[0], tt[1] != tt[0] ? tt[1] : -1);
+    const std::uint64_t key = edge_key(q[i], q[j]);
+    if (const auto* tt = edge_tags_.find(key)) {
+      Vec3* pr = projected_.find(key);  // boundary points never move: a safe cache
+      if (!pr) {
+        Vec3 y = o_.projection(mid, (*tt)[0], (*tt)[1] != (*tt)[0] ? (*tt)[1] : -1);
         if (!std::isfinite(y.x) || !std::isfinite(y.y) || !std::isfinite(y.z)) y = mid;
-        pr = projected_.emplace(key, y).first;
+        pr = &(projected_[key] = y);
       }
-      curved = curved || squared_distance(pr->second, mid) > 0;
-      mid = pr->second;
+      curved = curved || squared_distance(*pr, mid) > 0;
+      mid = *pr;
     }
     x[3 * (4 + e)] = mid.x, x[3 * (4 + e) + 1] = mid.y, x[3 * (4 + e) + 2] = mid.z;
   }

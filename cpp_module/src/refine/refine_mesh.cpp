@@ -322,6 +322,14 @@ EdgeKind RefineMesh::edge_kind(Index u, Index v, Index* tri_a, Index* tri_b) {
   return found[0].second == found[1].second ? EdgeKind::kInFace : EdgeKind::kOnInputEdge;
 }
 
+bool RefineMesh::is_interior_edge(Index u, Index v, const std::vector<Index>& shell) const {
+  if (support(u).kind == Support::kInterior || support(v).kind == Support::kInterior) return true;
+  for (Index t : shell)
+    for (Index x : tet(t))
+      if (x != u && x != v && is_boundary_face(u, v, x)) return false;
+  return true;
+}
+
 std::vector<std::array<Index, 2>> RefineMesh::edges() const {
   // Point by point, from each point's ball: its larger neighbours, sorted. This gives the edges in
   // sorted order without sorting all six edges of every tet.
@@ -747,7 +755,7 @@ bool RefineMesh::remove_edge(Index u, Index v, int max_ring, const TetsAccept& a
   const std::vector<Index> shell = tets_around_edge(u, v);
   const int n = static_cast<int>(shell.size());
   if (n < std::max(3, min_ring) || n > max_ring) return false;
-  if (edge_kind(u, v) != EdgeKind::kInterior) return false;
+  if (!is_interior_edge(u, v, shell)) return false;
   std::vector<std::pair<Index, Index>> links;
   if (!shell_links(u, v, shell, links)) return false;
   std::vector<Index> ring{links[0].first};

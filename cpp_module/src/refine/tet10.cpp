@@ -10,6 +10,7 @@
 #include <tuple>
 #include <vector>
 
+#include "bsptet/mesh/edge_map.h"
 #include "bsptet/mesh/tet_shape.h"
 
 namespace bsptet {
@@ -335,17 +336,15 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache&
   TetMesh lin = mesh.to_tet_mesh(&renum);
 
   // Boundary edges and their parent triangles' tags (new indices).
-  std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> boundary_edge_tags;
+  EdgeMap<std::array<std::int32_t, 2>> boundary_edge_tags;
   for (const auto& [face, parent] : mesh.boundary_faces())
     for (int k = 0; k < 3; ++k) {
-      Index a = renum[static_cast<std::size_t>(face[k])], b = renum[static_cast<std::size_t>(face[(k + 1) % 3])];
-      const std::array<Index, 2> key{std::min(a, b), std::max(a, b)};
+      const std::uint64_t key = edge_key(renum[static_cast<std::size_t>(face[k])], renum[static_cast<std::size_t>(face[(k + 1) % 3])]);
       const std::int32_t tag = mesh.tag_of(parent);
-      auto it = boundary_edge_tags.find(key);
-      if (it == boundary_edge_tags.end())
-        boundary_edge_tags.emplace(key, std::array<std::int32_t, 2>{tag, tag});
+      if (auto* tags = boundary_edge_tags.find(key))
+        (*tags)[1] = tag;
       else
-        it->second[1] = tag;
+        boundary_edge_tags[key] = {tag, tag};
     }
 
   std::vector<std::array<Index, 2>> edges;
@@ -377,9 +376,9 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache&
     const Vec3 a = lin.point(edges[i][0]), b = lin.point(edges[i][1]);
     straight[i] = {0.5 * (a.x + b.x), 0.5 * (a.y + b.y), 0.5 * (a.z + b.z)};
     Vec3 p = straight[i];
-    auto it = boundary_edge_tags.find(edges[i]);
-    if (hook && it != boundary_edge_tags.end()) {
-      const auto tags = it->second;
+    const auto* found = boundary_edge_tags.find(edge_key(edges[i][0], edges[i][1]));
+    if (hook && found) {
+      const auto tags = *found;
       const std::int32_t other = tags[1] != tags[0] ? tags[1] : -1;
       auto [at, fresh] = cache.try_emplace({p.x, p.y, p.z, tags[0], other});
       if (fresh) at->second = hook(p, tags[0], other);
@@ -440,13 +439,13 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache&
       }
     }
     for (std::size_t i = 0; i < edges.size(); ++i) {
-      auto it = boundary_edge_tags.find(edges[i]);
-      if (it == boundary_edge_tags.end()) continue;
-      tags[i] = it->second;
-      if (!hook || !placed[i] || is_fixed(it->second[0]) || is_fixed(it->second[1]))
+      const auto* found = boundary_edge_tags.find(edge_key(edges[i][0], edges[i][1]));
+      if (!found) continue;
+      tags[i] = *found;
+      if (!hook || !placed[i] || is_fixed((*found)[0]) || is_fixed((*found)[1]))
         move[i] = MidMove::kFixed;
       else
-        move[i] = it->second[0] != it->second[1] ? MidMove::kOnCurve : MidMove::kOnFace;
+        move[i] = (*found)[0] != (*found)[1] ? MidMove::kOnCurve : MidMove::kOnFace;
     }
     std::vector<std::vector<Index>> tets_of_mid(edges.size());
     for (Index t = 0; t < nk; ++t)
@@ -493,7 +492,7 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache&
         const std::size_t id = static_cast<std::size_t>(out.tet[static_cast<std::size_t>(10 * t + 4 + e)] - np);
         if (!curved[id]) continue;
         curved[id] = 0;
-        if (boundary_edge_tags.count(edges[id])) ++st.straightened;
+        if (boundary_edge_tags.find(edge_key(edges[id][0], edges[id][1]))) ++st.straightened;
         changed = true;
         const std::size_t at = static_cast<std::size_t>(3 * (np + static_cast<Index>(id)));
         out.xyz[at] = straight[id].x;

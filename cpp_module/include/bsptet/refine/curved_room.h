@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <map>
 
+#include "bsptet/mesh/edge_map.h"
 #include "bsptet/mesh/types.h"
 #include "bsptet/refine/mesh_optimizer.h"
 #include "bsptet/refine/quality_refine.h"
@@ -75,8 +76,8 @@ class CurvedRoom {
   RefineStats& st_;
   TargetSizes& size_;
   MeshOptimizer& opt_;
-  std::map<std::array<Index, 2>, std::array<std::int32_t, 2>> edge_tags_;  // prepare_check
-  std::map<std::array<Index, 2>, Vec3> projected_;  // hook results at boundary edge midpoints
+  EdgeMap<std::array<std::int32_t, 2>> edge_tags_;  // prepare_check (edge_key)
+  EdgeMap<Vec3> projected_;  // hook results at boundary edge midpoints (edge_key)
   double floor_deg_ = 1.0;  // lift: no new tet below min(this, the worst it replaces)
 };
 

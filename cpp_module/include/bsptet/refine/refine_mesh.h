@@ -272,6 +272,9 @@ class RefineMesh {
     std::size_t operator()(const FaceKey& k) const;
   };
   static FaceKey face_key(Index a, Index b, Index c);
+  /// edge_kind(u, v) == kInterior, for an edge whose tets (tets_around_edge) are `shell`: no
+  /// boundary face holds it.
+  bool is_interior_edge(Index u, Index v, const std::vector<Index>& shell) const;
   /// True when (a, b, c) is a boundary face. A face with an interior corner never is (supports
   /// are exact), which spares the hash lookup for most faces.
   bool is_boundary_face(Index a, Index b, Index c) const {
