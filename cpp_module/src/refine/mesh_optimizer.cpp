@@ -95,11 +95,13 @@ std::int64_t MeshOptimizer::flip_pass(double below) {
       const auto q = m_.tet(t);
       // The shell sizes of the six edges, looked up once: nothing changes until an operation
       // succeeds, and a 3-2 flip needs a shell of 3, an edge removal one of 4 to kMaxEdgeRing.
+      // One scan of each corner's ball counts the shells of its edges to the later corners.
       int shell[4][4] = {};
-      for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) {
-          m_.tets_around_edge(q[i], q[j], shell_);
-          shell[i][j] = static_cast<int>(shell_.size());
+      for (int i = 0; i < 3; ++i)
+        for (Index s : m_.tets_around_point(q[i])) {
+          const auto& r = m_.tet(s);
+          for (int j = i + 1; j < 4; ++j)
+            shell[i][j] += r[0] == q[j] || r[1] == q[j] || r[2] == q[j] || r[3] == q[j];
         }
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j)

@@ -188,7 +188,6 @@ class MeshOptimizer {
   TargetSizes& size_;
   FailureMemory flip_failed_, insert_failed_;
   PointFailureMemory odt_failed_, smooth_failed_;
-  std::vector<Index> shell_;  // flip_pass: scratch for a shell
 };
 
 }  // namespace bsptet
