@@ -153,21 +153,31 @@ bool cut_piece(std::vector<double>& points, Index first_cap_point, const std::ve
   std::vector<double> sums(n), sorted(n);
   for (int axis = 0; axis < 3; ++axis) {
     for (std::size_t t = 0; t < n; ++t) sums[t] = corner_sum(points, &tri[3 * t], axis);
+    // The quantiles are order statistics: successive selections, each in what the last left above.
     sorted = sums;
-    std::sort(sorted.begin(), sorted.end());
+    const double smallest = *std::min_element(sorted.begin(), sorted.end());
+    const std::size_t first = candidates.size();
+    std::size_t from = 0;
     for (int q = 6; q <= 14; ++q) {
-      const double threshold = sorted[std::min(n - 1, std::max<std::size_t>(1, n * static_cast<std::size_t>(q) / 20))];
-      if (threshold == sorted[0]) continue;
+      const std::size_t rank = std::min(n - 1, std::max<std::size_t>(1, n * static_cast<std::size_t>(q) / 20));
+      std::nth_element(sorted.begin() + static_cast<std::ptrdiff_t>(from), sorted.begin() + static_cast<std::ptrdiff_t>(rank), sorted.end());
+      from = rank;
+      const double threshold = sorted[rank];
+      if (threshold == smallest) continue;
       bool seen = false;
       for (const auto& c : candidates) seen = seen || (c.axis == axis && c.threshold == threshold);
-      if (seen) continue;
-      double weight = 0;
-      for (std::size_t i = 0; i < across.size(); ++i) {
-        const std::size_t t = i / 3, s = static_cast<std::size_t>(across[i]);
-        if (across[i] < 0 || (sums[t] < threshold) == (sums[s] < threshold)) continue;
-        weight += edge_length[i] * (touches_cap[t] || touches_cap[s] ? kCapEdgeWeight : 1);
-      }
-      candidates.push_back({weight, axis, threshold});
+      if (!seen) candidates.push_back({0, axis, threshold});
+    }
+    // One pass over the edges for this axis's thresholds (increasing): an edge is between the two
+    // sides of threshold T when its triangles' sums a, b have min(a, b) < T <= max(a, b).
+    for (std::size_t i = 0; i < across.size(); ++i) {
+      if (across[i] < 0) continue;
+      const std::size_t t = i / 3, u = static_cast<std::size_t>(across[i]);
+      const double lo = std::min(sums[t], sums[u]), hi = std::max(sums[t], sums[u]);
+      if (!(lo < hi)) continue;
+      const double w = edge_length[i] * (touches_cap[t] || touches_cap[u] ? kCapEdgeWeight : 1);
+      for (std::size_t c = first; c < candidates.size(); ++c)
+        if (lo < candidates[c].threshold && candidates[c].threshold <= hi) candidates[c].weight += w;
     }
   }
   std::stable_sort(candidates.begin(), candidates.end(),

@@ -404,28 +404,39 @@ std::int64_t add_cap_points(CapTriangulation& cap, std::size_t m, const Projecti
 }  // namespace
 
 SolidTopology::SolidTopology(const std::vector<Index>& tri) {
+  // Counting sorts by vertex (linear in the surface; a comparison sort of every directed edge
+  // and corner was most of a large cut's time): each vertex's directed edges and corners in
+  // triangle order, its edges then ordered by their other end (a handful each).
   const std::size_t n = tri.size() / 3;
+  Index top = -1;
+  for (Index v : tri) top = std::max(top, v);
+  edge_start.assign(static_cast<std::size_t>(top) + 2, 0);
+  for (Index v : tri) ++edge_start[static_cast<std::size_t>(v) + 1];
+  for (std::size_t v = 1; v < edge_start.size(); ++v) edge_start[v] += edge_start[v - 1];
   edges.resize(tri.size());
   corners.resize(tri.size());
+  std::vector<Index> fill(edge_start.begin(), edge_start.end() - 1);
   for (std::size_t t = 0; t < n; ++t)
     for (int k = 0; k < 3; ++k) {
-      edges[3 * t + k] = {tri[3 * t + k], tri[3 * t + (k + 1) % 3], static_cast<Index>(t)};
-      corners[3 * t + k] = {tri[3 * t + k], static_cast<Index>(t)};
+      const Index u = tri[3 * t + k];
+      const std::size_t at = static_cast<std::size_t>(fill[static_cast<std::size_t>(u)]++);
+      edges[at] = {u, tri[3 * t + (k + 1) % 3], static_cast<Index>(t)};
+      corners[at] = {u, static_cast<Index>(t)};
     }
-  std::sort(edges.begin(), edges.end(), [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
-    return e[0] != f[0] ? e[0] < f[0] : e[1] < f[1];
-  });
-  std::sort(corners.begin(), corners.end());
+  for (std::size_t v = 0; v + 1 < edge_start.size(); ++v)
+    std::sort(edges.begin() + edge_start[v], edges.begin() + edge_start[v + 1],
+              [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
+                return e[1] != f[1] ? e[1] < f[1] : e[2] < f[2];
+              });
   across.resize(tri.size());
   for (std::size_t i = 0; i < tri.size(); ++i) across[i] = triangle_of(tri[i / 3 * 3 + (i + 1) % 3], tri[i]);
 }
 
 Index SolidTopology::triangle_of(Index u, Index v) const {
-  auto it = std::lower_bound(edges.begin(), edges.end(), std::array<Index, 3>{u, v, 0},
-                             [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
-                               return e[0] != f[0] ? e[0] < f[0] : e[1] < f[1];
-                             });
-  return it != edges.end() && (*it)[0] == u && (*it)[1] == v ? (*it)[2] : -1;
+  if (u < 0 || static_cast<std::size_t>(u) + 1 >= edge_start.size()) return -1;
+  for (Index i = edge_start[static_cast<std::size_t>(u)]; i < edge_start[static_cast<std::size_t>(u) + 1]; ++i)
+    if (edges[static_cast<std::size_t>(i)][1] == v) return edges[static_cast<std::size_t>(i)][2];
+  return -1;
 }
 
 std::vector<Index> edge_neighbours(const std::vector<Index>& tri) { return SolidTopology(tri).across; }

@@ -64,7 +64,8 @@ struct SolidTopology {
   explicit SolidTopology(const std::vector<Index>& tri);
   /// The triangle holding the directed edge u -> v, or -1.
   Index triangle_of(Index u, Index v) const;
-  std::vector<std::array<Index, 3>> edges;        ///< (u, v, triangle) per directed edge, sorted by (u, v)
+  std::vector<std::array<Index, 3>> edges;        ///< (u, v, triangle) per directed edge, sorted by (u, v, triangle)
+  std::vector<Index> edge_start;                  ///< vertex u's edges (and corners) start at edge_start[u]
   std::vector<Index> across;                      ///< as edge_neighbours
   std::vector<std::pair<Index, Index>> corners;  ///< (vertex, triangle), sorted: each vertex's fan
 };
