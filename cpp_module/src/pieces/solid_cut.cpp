@@ -415,14 +415,17 @@ SolidTopology::SolidTopology(const std::vector<Index>& tri) {
   for (std::size_t v = 1; v < edge_start.size(); ++v) edge_start[v] += edge_start[v - 1];
   edges.resize(tri.size());
   corners.resize(tri.size());
-  std::vector<Index> fill(edge_start.begin(), edge_start.end() - 1);
+  // Filled through the starts (each ends at the next vertex's start), then shifted back: the
+  // only array as long as the vertex ids (a piece's ids are the whole solid's).
   for (std::size_t t = 0; t < n; ++t)
     for (int k = 0; k < 3; ++k) {
       const Index u = tri[3 * t + k];
-      const std::size_t at = static_cast<std::size_t>(fill[static_cast<std::size_t>(u)]++);
+      const std::size_t at = static_cast<std::size_t>(edge_start[static_cast<std::size_t>(u)]++);
       edges[at] = {u, tri[3 * t + (k + 1) % 3], static_cast<Index>(t)};
       corners[at] = {u, static_cast<Index>(t)};
     }
+  for (std::size_t v = edge_start.size() - 1; v > 0; --v) edge_start[v] = edge_start[v - 1];
+  edge_start[0] = 0;
   for (std::size_t v = 0; v + 1 < edge_start.size(); ++v)
     std::sort(edges.begin() + edge_start[v], edges.begin() + edge_start[v + 1],
               [](const std::array<Index, 3>& e, const std::array<Index, 3>& f) {
