@@ -404,8 +404,8 @@ std::int64_t add_cap_points(CapTriangulation& cap, std::size_t m, const Projecti
 }  // namespace
 
 SolidTopology::SolidTopology(const std::vector<Index>& tri) {
-  // Counting sorts by vertex (linear in the surface; a comparison sort of every directed edge
-  // and corner was most of a large cut's time): each vertex's directed edges and corners in
+  // Counting sorts by vertex, linear in the surface (a comparison sort of every directed edge and
+  // corner would be most of a large cut's time): each vertex's directed edges and corners in
   // triangle order, its edges then ordered by their other end (a handful each).
   const std::size_t n = tri.size() / 3;
   Index top = -1;

@@ -221,17 +221,8 @@ void CurvedRoom::lift_rounds() {
 
 // Once the surface is final: the tags of each boundary edge's faces, for the projection hook.
 void CurvedRoom::prepare_check() {
-  edge_tags_.release();
+  edge_tags_ = m_.boundary_edge_tags();
   projected_.release();
-  for (const auto& [face, parent] : m_.boundary_faces())
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t key = edge_key(face[k], face[(k + 1) % 3]);
-      const std::int32_t tag = m_.tag_of(parent);
-      if (auto* tags = edge_tags_.find(key))
-        (*tags)[1] = tag;
-      else
-        edge_tags_[key] = {tag, tag};
-    }
 }
 
 // True when the tet10 of corners q at positions P, its boundary edges' mid-nodes on the true

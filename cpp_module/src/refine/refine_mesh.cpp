@@ -1094,6 +1094,22 @@ TetMesh RefineMesh::to_tet_mesh(std::vector<Index>* old_to_new) const {
   return out;
 }
 
+EdgeMap<std::array<std::int32_t, 2>> RefineMesh::boundary_edge_tags(const std::vector<Index>* renum) {
+  EdgeMap<std::array<std::int32_t, 2>> out;
+  for (const auto& [face, parent] : boundary_faces())
+    for (int k = 0; k < 3; ++k) {
+      Index a = face[k], b = face[(k + 1) % 3];
+      if (renum) a = (*renum)[static_cast<std::size_t>(a)], b = (*renum)[static_cast<std::size_t>(b)];
+      const std::uint64_t key = edge_key(a, b);
+      const std::int32_t tag = tag_of(parent);
+      if (auto* tags = out.find(key))
+        (*tags)[1] = tag;
+      else
+        out[key] = {tag, tag};
+    }
+  return out;
+}
+
 std::vector<std::pair<std::array<Index, 3>, Index>> RefineMesh::boundary_faces() {
   std::vector<std::pair<std::array<Index, 3>, Index>> out;
   out.reserve(boundary_.size());

@@ -10,7 +10,6 @@
 #include <tuple>
 #include <vector>
 
-#include "bsptet/mesh/edge_map.h"
 #include "bsptet/mesh/tet_shape.h"
 
 namespace bsptet {
@@ -336,16 +335,7 @@ TetMesh lift_once(RefineMesh& mesh, const ProjectionHook& hook, ProjectionCache&
   TetMesh lin = mesh.to_tet_mesh(&renum);
 
   // Boundary edges and their parent triangles' tags (new indices).
-  EdgeMap<std::array<std::int32_t, 2>> boundary_edge_tags;
-  for (const auto& [face, parent] : mesh.boundary_faces())
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t key = edge_key(renum[static_cast<std::size_t>(face[k])], renum[static_cast<std::size_t>(face[(k + 1) % 3])]);
-      const std::int32_t tag = mesh.tag_of(parent);
-      if (auto* tags = boundary_edge_tags.find(key))
-        (*tags)[1] = tag;
-      else
-        boundary_edge_tags[key] = {tag, tag};
-    }
+  const EdgeMap<std::array<std::int32_t, 2>> boundary_edge_tags = mesh.boundary_edge_tags(&renum);
 
   std::vector<std::array<Index, 2>> edges;
   const Index nk = lin.num_tets();

@@ -34,6 +34,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bsptet/mesh/edge_map.h"
 #include "bsptet/mesh/projection_hook.h"
 #include "bsptet/mesh/types.h"
 
@@ -265,6 +266,9 @@ class RefineMesh {
   /// The boundary faces as (face, parent input triangle), vertices as mesh indices, oriented
   /// outward, sorted.
   std::vector<std::pair<std::array<Index, 3>, Index>> boundary_faces();
+  /// For every boundary edge (edge_key of its ends, renumbered through `renum` when given): the
+  /// face tags of its two boundary faces' parents, the first met and the last (equal inside a face).
+  EdgeMap<std::array<std::int32_t, 2>> boundary_edge_tags(const std::vector<Index>* renum = nullptr);
 
  private:
   using FaceKey = std::array<Index, 3>;
