@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """FemBspTet: BSP-assisted constrained tetrahedralization for FreeCAD FEM.
 
-The compiled core is the private extension ``FemBspTet._bsptet`` (built by ``scripts/setup.sh``).
+The compiled code is two private extensions (built by ``scripts/setup.sh``): ``FemBspTet._bsptet``,
+the core, and ``FemBspTet._bsptet_cad``, the FEM pipeline from CAD (it loads OpenCASCADE).
 Importing this package never imports FreeCAD; the FreeCAD layer is imported on demand:
 ``make_mesher``, ``run_mesher``, ``mesh_shape`` and ``export_mesh`` (see
 :mod:`FemBspTet.freecad.mesher_tools`) import it when called.

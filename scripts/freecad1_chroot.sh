@@ -193,8 +193,10 @@ if [ ! -f "$SRC/$BUILD/CMakeCache.txt" ]; then
 fi
 in_chroot cmake --build "$INSIDE/$BUILD" -j1 || die "the build failed in the chroot"
 suffix=$(in_chroot /usr/bin/python3 -c 'import sysconfig; print(sysconfig.get_config_var("EXT_SUFFIX"))')
-[ -f "$SRC/FemBspTet/_bsptet$suffix" ] || die "the build made no FemBspTet/_bsptet$suffix"
-say "built FemBspTet/_bsptet$suffix"
+for module in _bsptet _bsptet_cad; do
+  [ -f "$SRC/FemBspTet/$module$suffix" ] || die "the build made no FemBspTet/$module$suffix"
+done
+say "built FemBspTet/_bsptet$suffix and _bsptet_cad$suffix"
 
 # ---- 5. the command ----------------------------------------------------------------------------------
 if ((${#CMD[@]})); then

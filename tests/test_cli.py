@@ -114,6 +114,31 @@ def test_mesh_second_order_is_valid(cli, tmp_path):
     assert json.loads(r.stdout)["inconsistent_midnodes"] == 0
 
 
+def test_a_surface_meshes_in_one_process_without_opencascade_or_freecad(tmp_path):
+    """The start-up of ``fembsptet mesh SURFACE``: the command runs in this process (no
+    supervisor child without --timeout or --max-memory) and loads neither the CAD extension
+    (OpenCASCADE's libraries), FreeCAD, nor the comparison, picture and cluster modules."""
+    out = tmp_path / "cube.vtu"
+    code = (
+        "import os, sys\n"
+        "from FemBspTet.cli.main import main\n"
+        "pid = os.getpid()\n"
+        f"rc = main(['mesh', {os.path.join(ROOT, 'tests', 'data', 'corpus', 'cube.off')!r}, '-o', "
+        f"{str(out)!r}, '--quiet'])\n"
+        "maps = open('/proc/self/maps').read()\n"
+        "print(rc, os.getpid() == pid, 'libTKernel' in maps, ' '.join(sorted(m for m in sys.modules if "
+        "m.startswith(('FemBspTet._bsptet_cad', 'FreeCAD', 'Part', 'matplotlib', 'distributed', "
+        "'FemBspTet.compare', 'FemBspTet.freecad', 'FemBspTet.io.render')))))\n")
+    r = subprocess.run(["/usr/bin/python3", "-c", code], capture_output=True, text=True, timeout=120,
+                       cwd=ROOT, env={**os.environ, "PYTHONPATH": ROOT})
+    assert r.returncode == 0, r.stderr
+    rc, same_process, occ, *loaded = r.stdout.split()
+    assert rc == "0" and same_process == "True"
+    assert occ == "False", "OpenCASCADE's libraries were loaded to mesh a triangle surface"
+    assert loaded == [], f"modules the surface path does not need: {loaded}"
+    assert out.stat().st_size > 0
+
+
 def test_mesh_prints_stats_and_tetgen_table(cli, tmp_path):
     r = run(cli, "mesh", paper_path("schoenhardt"), "-o", tmp_path / "s.vtu", "--compare-tetgen",
             "--json")

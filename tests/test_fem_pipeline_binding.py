@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The C++ FEM pipeline from CAD through the binding (_bsptet.mesh_cad_file / mesh_cad_brep):
+"""The C++ FEM pipeline from CAD through the binding (_bsptet_cad.mesh_cad_file / mesh_cad_brep):
 arrays of the documented shapes, every tet positive and checked exactly, every CAD face and solid
 present, and (with FreeCAD) every node of a face's triangles found by FemMesh.getNodesByFace on a
 moved and rotated part with a hole.
@@ -11,7 +11,7 @@ import re
 import numpy as np
 import pytest
 
-from FemBspTet import _bsptet
+from FemBspTet import _bsptet, _bsptet_cad
 from FemBspTet.kernel.freecad_env import freecad_available
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "cad")
@@ -42,7 +42,7 @@ def check(points, tets, tet_solid, triangles, triangle_face, stats, solid_names,
 
 
 def options(**values):
-    o = _bsptet.FemOptions()
+    o = _bsptet_cad.FemOptions()
     for name, value in values.items():
         setattr(o, name, value)
     return o
@@ -55,10 +55,10 @@ def test_the_options_schema_is_one_table():
     from FemBspTet.fem.cad_mesh import fem_options
     from FemBspTet.fem.mesh_pipeline import FEM_OPTION_OF_PARAMETER, MeshParameters
 
-    names = list(_bsptet.FemOptions.names)
+    names = list(_bsptet_cad.FemOptions.names)
     assert names == ["size", "min_size", "size_by_face", "points_per_circle", "grading", "order",
                      "optimize_rounds", "face_rounds", "workers"]
-    o = _bsptet.FemOptions()
+    o = _bsptet_cad.FemOptions()
     assert (o.size, o.min_size, o.order, o.grading, o.points_per_circle, o.workers) == \
         (0, 0, 2, 0.3, 12, 0)
     with pytest.raises(AttributeError):
@@ -75,7 +75,7 @@ def test_the_options_schema_is_one_table():
     assert set(FEM_OPTION_OF_PARAMETER) <= fields
     assert set(FEM_OPTION_OF_PARAMETER.values()) <= set(names)
     # the statistics keys are the FemStats fields
-    stats = _bsptet.FemStats()
+    stats = _bsptet_cad.FemStats()
     keys = set(stats.to_dict())
     assert {"solids", "faces", "size", "nodes", "tets", "min_dihedral_deg", "seconds_total",
             "median_tet_min_dihedral_deg", "refine_seconds_by_pass"} <= keys
@@ -84,7 +84,7 @@ def test_the_options_schema_is_one_table():
 
 @pytest.mark.parametrize("order", [1, 2])
 def test_mesh_cad_file_red_cube_blue_cylinder(order):
-    out = _bsptet.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"),
+    out = _bsptet_cad.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"),
                                 options=options(order=order))
     check(*out, order=order, solids=2, faces=9)
     stats, solid_names, face_names = out[5:]
@@ -105,18 +105,18 @@ def test_mesh_cad_file_red_cube_blue_cylinder(order):
 def test_bad_options_and_files_raise_value_errors():
     path = os.path.join(DATA, "red_cube_blue_cylinder.step")
     with pytest.raises(ValueError, match="order"):
-        _bsptet.mesh_cad_file(path, options=options(order=3))
+        _bsptet_cad.mesh_cad_file(path, options=options(order=3))
     with pytest.raises(ValueError, match="size"):
-        _bsptet.mesh_cad_file(path, options=options(size=-1.0))
+        _bsptet_cad.mesh_cad_file(path, options=options(size=-1.0))
     with pytest.raises(ValueError):
-        _bsptet.mesh_cad_file(os.path.join(DATA, "no_such_part.step"))
+        _bsptet_cad.mesh_cad_file(os.path.join(DATA, "no_such_part.step"))
     with pytest.raises(ValueError):
-        _bsptet.mesh_cad_brep("not a shape")
+        _bsptet_cad.mesh_cad_brep("not a shape")
 
 
 def test_cancel_raises_meshing_error():
     with pytest.raises(RuntimeError) as info:
-        _bsptet.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"), cancel=lambda: True)
+        _bsptet_cad.mesh_cad_file(os.path.join(DATA, "red_cube_blue_cylinder.step"), cancel=lambda: True)
     assert info.value.code == "cancelled"
 
 
@@ -132,7 +132,7 @@ def test_mesh_cad_brep_nodes_found_by_face(order):
     shape = Part.makeBox(60, 40, 8).cut(Part.makeCylinder(10, 8, freecad.Vector(30, 20, 0)))
     shape.Placement = freecad.Placement(freecad.Vector(3.5, -7.25, 11.0),
                                         freecad.Rotation(freecad.Vector(1, 2, 3), 37.0))
-    out = _bsptet.mesh_cad_brep(shape.exportBrepToString(), options=options(order=order))
+    out = _bsptet_cad.mesh_cad_brep(shape.exportBrepToString(), options=options(order=order))
     points, tets, _, triangles, triangle_face = out[:5]
     assert out[7] == [f"Face{k}" for k in range(1, len(shape.Faces) + 1)]  # a BREP has no names
     check(*out, order=order, solids=1, faces=len(shape.Faces))
@@ -158,7 +158,7 @@ def test_step_names_become_unique_set_names(tmp_path):
     text = text.replace("@'", "'")
     path = tmp_path / "renamed.step"
     path.write_text(text)
-    _, _, _, _, tri_face, _, solid_names, face_names = _bsptet.mesh_cad_file(
+    _, _, _, _, tri_face, _, solid_names, face_names = _bsptet_cad.mesh_cad_file(
         str(path), dimension=2, options=options(order=1))
     assert solid_names == ["blue_cylinder_Solid1", "Blue_Cylinder_Solid2"]  # equal up to case
     assert len({n.upper() for n in solid_names + face_names}) == len(solid_names) + len(face_names)
@@ -173,7 +173,7 @@ def test_solids_meshed_at_the_same_time_give_the_same_mesh():
     """FemOptions.workers solids at a time, each on its own thread: the arrays are identical for
     1 and 2 workers and for every core (0), and the mesh is valid."""
     path = os.path.join(DATA, "red_cube_blue_cylinder.step")
-    runs = [_bsptet.mesh_cad_file(path, options=options(order=2, workers=w)) for w in (1, 2, 0)]
+    runs = [_bsptet_cad.mesh_cad_file(path, options=options(order=2, workers=w)) for w in (1, 2, 0)]
     check(*runs[1], order=2, solids=2, faces=9)
     for other in runs[1:]:
         for a, b in zip(runs[0][:5], other[:5]):
@@ -181,4 +181,4 @@ def test_solids_meshed_at_the_same_time_give_the_same_mesh():
         assert other[6:] == runs[0][6:]
         assert other[5]["tets"] == runs[0][5]["tets"]
     with pytest.raises(ValueError, match="workers"):
-        _bsptet.mesh_cad_file(path, options=options(workers=-1))
+        _bsptet_cad.mesh_cad_file(path, options=options(workers=-1))

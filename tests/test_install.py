@@ -41,7 +41,8 @@ def test_the_installed_command_meshes_from_anywhere(prefix, tmp_path):
     assert os.path.islink(exe) and os.access(exe, os.X_OK)
     addon = prefix / "share" / "fembsptet" / "FemBspTet"
     assert os.path.realpath(exe) == str(addon / "bin" / "fembsptet")
-    assert list((addon / "FemBspTet").glob("_bsptet*.so"))
+    assert list((addon / "FemBspTet").glob("_bsptet.*.so"))
+    assert list((addon / "FemBspTet").glob("_bsptet_cad.*.so"))
     assert (addon / "libexec" / "bsptet_mesh").is_file()
     out = tmp_path / "m.vtu"
     r = subprocess.run([str(exe), "mesh", os.path.join(ROOT, "tests", "data", "cad",

@@ -15,8 +15,10 @@
 timed-out mesher is a row that says so). Exit codes: 0 success; 2 bad input (the message says what and where), also for ``check`` when the
 mesh is not valid, and for a run over its memory budget; 1 internal failure (also a crash of the
 native code); 124 time limit reached (--timeout); 130 interrupted (Ctrl-C, SIGTERM).
-``mesh`` runs its work in a supervised child process (:mod:`FemBspTet.cli.supervisor`): Ctrl-C,
---timeout and the memory budget stop it within a fraction of a second, with no partial file.
+``mesh`` runs in this process, stopped at once by Ctrl-C with no partial file; with --timeout or
+--max-memory it runs in a supervised child process (:mod:`FemBspTet.cli.supervisor`) that
+enforces them. Each command imports what it needs when it runs: a surface file meshes without
+loading OpenCASCADE, FreeCAD or the comparison and picture modules.
 Run it as ``bin/fembsptet`` (Debian's /usr/bin/python3) or ``/usr/bin/python3 -m FemBspTet.cli.main``.
 """
 
@@ -30,18 +32,10 @@ import time
 import numpy as np
 
 from .. import __version__
-from ..compare.benchmark import model_paths, run_benchmark, write_report
-from ..compare.comparison import (compare, format_rows, format_table, MESHERS, plot_histograms,
-                                  row_from_stats, tetgen_pY_row, write_json)
-from ..fem.cad_check import check_against_cad
-from ..fem.cad_mesh import mesh_cad_faces_file, mesh_cad_file
-from ..freecad.femmesh import read_via_freecad, write_via_freecad
 from ..io.atomic_file import atomic_output
-from ..io.cad_tessellation import tessellate_file
 from ..io.formats import (CAD_EXTENSIONS, extension, FREECAD_VOLUME_EXTENSIONS,
                           SURFACE_EXTENSIONS, VOLUME_EXTENSIONS)
 from ..io.inputs import load_input
-from ..io.render import render_bsp_cells, render_mesh
 from ..io.surface_io import read_surface, write_surface
 from ..io.volume_io import (MSH_VERSIONS, read_tet_mesh, stored_points, surface_groups,
                             write_tet_mesh)
@@ -51,9 +45,7 @@ from ..kernel.memory_budget import default_budget, parse_size
 from ..kernel.mesh_types import MeshGroups, Surface, TetMesh
 from ..kernel.progress import Progress
 from ..peers.process import DEFAULT_TIMEOUT
-from .addon_install import install
 from .supervisor import Limits, run_interruptible, run_supervised
-from ..fem.pieces import default_workers, tetrahedralize_in_pieces
 
 
 # Keys of the stats JSON that scripts may rely on (stable; new keys may be added).
@@ -104,7 +96,7 @@ def write_output(path, mesh, groups=None, msh_version="2.2"):
     """Write ``mesh`` (with its named sets ``groups``, a MeshGroups, when given) to ``path``."""
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
-
+        from ..freecad.femmesh import write_via_freecad
         write_via_freecad(path, mesh, groups)
     else:
 
@@ -135,7 +127,7 @@ def _check_stored(path, mesh):
 def read_volume(path):
     ext = _ext(path)
     if ext in FREECAD_VOLUME_EXTENSIONS:
-
+        from ..freecad.femmesh import read_via_freecad
         return read_via_freecad(path)
     if ext in VOLUME_EXTENSIONS:
 
@@ -205,6 +197,7 @@ def _mesh_cad_fem(args, progress):
     """The default for a CAD file: the FEM path (FemBspTet.fem.cad_mesh, no FreeCAD): the CAD
     surface meshed at the size, the exact core, refinement with points and tet10 mid-nodes on
     the CAD. Returns (mesh, stats, MeshGroups: CAD faces and solids)."""
+    from ..fem.cad_mesh import mesh_cad_faces_file, mesh_cad_file
     unsupported = [name for name, value in (("--min-dihedral", args.min_dihedral),
                                             ("--radius-edge", args.radius_edge),
                                             ("--thickness-ratio", args.thickness_ratio),
@@ -274,6 +267,7 @@ def _cmd_mesh(args):
                                  ("steiner_effort", args.steiner_effort),
                                  ("bsp_seed", args.bsp_seed), ("reorient", args.reorient))
                if v not in (None, False) and not (k == "order" and v == 1)}
+    from ..fem.pieces import default_workers, tetrahedralize_in_pieces
     workers = args.workers
     core_only = not set(options) - {"steiner_effort", "bsp_seed", "reorient"}
     if workers is None and args.scheduler is None:
@@ -343,7 +337,7 @@ def _finish_mesh(args, progress, t0, mesh, stats, surfaces, groups=None):
         print(mesh_summary(args.input, args.output, mesh, stats, groups))
     if args.compare_tetgen:
         if surfaces is None:
-
+            from ..io.cad_tessellation import tessellate_file
             surfaces = tessellate_file(args.input, size=args.size)
         print(_tetgen_table(surfaces, stats))
     return 0
@@ -418,7 +412,7 @@ def mesh_summary(source, outputs, mesh, stats, groups):
 
 def _tetgen_table(surfaces, stats):
     """Our counts beside `tetgen -pY` on the same surface(s) (compare/comparison.py)."""
-
+    from ..compare.comparison import format_rows, row_from_stats, tetgen_pY_row
     return format_rows([row_from_stats(stats), tetgen_pY_row(surfaces)])
 
 
@@ -497,7 +491,7 @@ def _cmd_check(args):
 def _check_against_cad(args):
     """``check PART.step MESH``: the mesh's own exact validity, tet10 certified, and its boundary
     nodes on the CAD faces (FemBspTet.fem.cad_check)."""
-
+    from ..fem.cad_check import check_against_cad
     if not os.path.isfile(args.surface):
         raise InputError("file not found", where=args.surface)
     mesh = read_volume(args.tetmesh)
@@ -523,7 +517,7 @@ def _check_against_cad(args):
 
 
 def _cmd_render(args):
-
+    from ..io.render import render_mesh
     if _ext(args.output) != ".png":
         raise InputError("the picture is written as PNG: name it FILE.png", where=args.output)
     parent = os.path.dirname(os.path.abspath(args.output))
@@ -537,6 +531,7 @@ def _cmd_render(args):
 
 
 def _cmd_cells(args):
+    from ..io.render import render_bsp_cells
     if _ext(args.output) != ".png":
         raise InputError("the picture is written as PNG: name it FILE.png", where=args.output)
     surfaces = load_input(args.input)
@@ -549,7 +544,7 @@ def _cmd_cells(args):
 
 
 def _cmd_freecad_install(args):
-
+    from .addon_install import install
     for line in install(args.mod_dir, uninstall=args.uninstall):
         print(f"fembsptet: {line}")
     if not args.uninstall:
@@ -565,7 +560,7 @@ def _positive_option(value, option):
 
 def _cmd_compare(args):
     """Our mesher, TetGen and Gmsh on the same surface: one table (compare/comparison.py)."""
-
+    from ..compare.comparison import compare, format_table, MESHERS, plot_histograms, write_json
     _positive_option(args.size, "--size")
     _positive_option(args.timeout, "--timeout")
     meshers = tuple(m for m in args.meshers.split(",") if m) if args.meshers else MESHERS
@@ -589,7 +584,8 @@ def _cmd_compare(args):
 
 def _cmd_benchmark(args):
     """``compare`` over folders of models, as a markdown report (compare/benchmark.py)."""
-
+    from ..compare.benchmark import model_paths, run_benchmark, write_report
+    from ..compare.comparison import MESHERS
     _positive_option(args.divisions, "--divisions")
     _positive_option(args.timeout, "--timeout")
     if not os.path.isdir(os.path.dirname(os.path.abspath(args.report))):

@@ -21,7 +21,7 @@ exact check of the whole mesh reports those faces as crossing: check such a mesh
 import numpy as np
 
 from ..io.volume_io import triangle_midnodes, triangle_tags_in_file
-from ..kernel.core import boundary_surface, certify_tet10, check_mesh, native
+from ..kernel.core import boundary_surface, certify_tet10, check_mesh, native_cad
 from ..kernel.mesh_types import TetMesh
 
 def _boundary_nodes(mesh, triangles):
@@ -64,7 +64,7 @@ def check_against_cad(cad_path, mesh: TetMesh, max_messages=20):
     nodes, tags = nodes[order], tags[order]
     first = np.concatenate([[True], nodes[1:] != nodes[:-1]])
     nodes, tags = nodes[first], tags[first]
-    distance, face, tolerance = native().cad_face_distances(
+    distance, face, tolerance = native_cad().cad_face_distances(
         str(cad_path), np.ascontiguousarray(mesh.points[nodes]), tags.astype(np.int32))
     distance, face = np.asarray(distance), np.asarray(face)
     limit = np.asarray(tolerance)[face]

@@ -18,7 +18,7 @@ import dataclasses
 
 import numpy as np
 
-from ..kernel.core import core_errors, native, boundary_surface, check_mesh
+from ..kernel.core import core_errors, native_cad, boundary_surface, check_mesh
 from ..kernel.errors import InputError, InternalError
 from ..kernel.mesh_types import MeshGroups, Surface, TetMesh, triangle_keys
 
@@ -107,11 +107,11 @@ def fem_options(source="", **values):
     ``values`` set: ``size``, ``min_size``, ``order``, ``size_by_face``, ``points_per_circle``,
     ``grading``, ``optimize_rounds``, ``face_rounds``, ``workers`` (None: the default). Raises InputError for
     an unknown name or a value out of range, naming ``source``."""
-    options = native().FemOptions()
-    unknown = sorted(set(values) - set(native().FemOptions.names))
+    options = native_cad().FemOptions()
+    unknown = sorted(set(values) - set(native_cad().FemOptions.names))
     if unknown:
         raise InputError("unknown FEM option(s) %s; the options are %s"
-                         % (", ".join(unknown), ", ".join(native().FemOptions.names)), where=source)
+                         % (", ".join(unknown), ", ".join(native_cad().FemOptions.names)), where=source)
     order = values.get("order")
     if order is not None and order not in (1, 2):
         raise InputError(f"order must be 1 or 2, got {order}", where=source)
@@ -190,7 +190,7 @@ def mesh_cad_file(path, size=0.0, min_size=0.0, order=2, progress=None, cancel=N
     Raises InputError (unreadable or unmeshable part, naming the CAD face or solid; bad option)
     or MeshingError."""
 
-    return _run(lambda **kw: native().mesh_cad_file(str(path), **kw), str(path), size, min_size,
+    return _run(lambda **kw: native_cad().mesh_cad_file(str(path), **kw), str(path), size, min_size,
                 order, progress, cancel, size_by_face, workers)
 
 
@@ -198,7 +198,7 @@ def mesh_cad_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, cancel=N
                   size_by_face=None, source="BREP string", workers=None):
     """The same for a shape in OpenCASCADE's BREP text (FreeCAD's ``Shape.exportBrepToString()``)."""
 
-    return _run(lambda **kw: native().mesh_cad_brep(brep, **kw), source, size, min_size, order,
+    return _run(lambda **kw: native_cad().mesh_cad_brep(brep, **kw), source, size, min_size, order,
                 progress, cancel, size_by_face, workers)
 
 
@@ -221,7 +221,7 @@ def mesh_cad_faces_brep(brep, size=0.0, min_size=0.0, order=2, progress=None, ca
     triangles at the size field, tria6 mid-nodes on the CAD (``cpp_module/include/bsptet/fem/
     fem_faces.h``): shell and plane analyses, on one thread (``workers`` is accepted for the
     3D path's sake and not used). Raises InputError (no face, bad option) or MeshingError."""
-    return _faces(lambda **kw: native().mesh_cad_brep(brep, dimension=2, **kw), source, size,
+    return _faces(lambda **kw: native_cad().mesh_cad_brep(brep, dimension=2, **kw), source, size,
                   min_size, order, progress, cancel, size_by_face, workers)
 
 
@@ -229,7 +229,7 @@ def mesh_cad_faces_file(path, size=0.0, min_size=0.0, order=2, progress=None, ca
                         size_by_face=None, workers=None):
     """The same for the faces in a STEP, BREP or IGES file (the command line's
     ``--dimension 2``)."""
-    return _faces(lambda **kw: native().mesh_cad_file(str(path), dimension=2, **kw), str(path),
+    return _faces(lambda **kw: native_cad().mesh_cad_file(str(path), dimension=2, **kw), str(path),
                   size, min_size, order, progress, cancel, size_by_face, workers)
 
 

@@ -57,7 +57,8 @@ def _checked(reference, mesh, what, source=None):
 
 
 def native():
-    """The compiled core, with a message that says how to build it when it is missing."""
+    """The compiled core (no OpenCASCADE), with a message that says how to build it when it is
+    missing."""
     try:
         from .. import _bsptet
     except ImportError as exc:  # pragma: no cover - depends on the build
@@ -66,6 +67,19 @@ def native():
             f"({exc}); run scripts/setup.sh (it installs what is missing and builds the core)"
         ) from exc
     return _bsptet
+
+
+def native_cad():
+    """The compiled FEM pipeline from CAD, the extension that loads OpenCASCADE (only the CAD
+    paths import it, so a triangle surface meshes without it)."""
+    try:
+        from .. import _bsptet_cad
+    except ImportError as exc:  # pragma: no cover - depends on the build
+        raise InternalError(
+            "the C++ FEM pipeline FemBspTet._bsptet_cad is not built or does not load "
+            f"({exc}); run scripts/setup.sh (it installs what is missing and builds the core)"
+        ) from exc
+    return _bsptet_cad
 
 
 def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_quality=True):

@@ -1,20 +1,16 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pybind11 bindings of the FemBspTet core: `FemBspTet._bsptet`. Converts and validates only; the
-// public Python API lives in FemBspTet/kernel/core.py. Messages name the expected array shapes.
+// pybind11 bindings of the FemBspTet core: `FemBspTet._bsptet`, everything but the FEM pipeline
+// from CAD (cad_module.cpp, `_bsptet_cad`): it links no OpenCASCADE, so a triangle surface
+// meshes without loading it. Converts and validates only; the public Python API lives in
+// FemBspTet/kernel/core.py. Messages name the expected array shapes.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <atomic>
-#include <functional>
-#include <map>
 #include <string>
 
-#include "bsptet/cad/cad_distance.h"
-#include "bsptet/cad/cad_model.h"
+#include "binding_support.h"
 #include "bsptet/numerics/errors.h"
-#include "bsptet/fem/fem_faces.h"
-#include "bsptet/fem/fem_mesh.h"
 #include "bsptet/mesh/mesh_check.h"
 #include "bsptet/core/mesher.h"
 #include "bsptet/pieces/out_of_core.h"
@@ -25,33 +21,9 @@
 
 namespace py = pybind11;
 using namespace bsptet;
+using namespace bsptet::bindings;
 
 namespace {
-
-using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
-
-std::vector<double> points_from(const DoubleArray& a, const char* name) {
-  if (a.ndim() != 2 || a.shape(1) != 3)
-    throw py::value_error(std::string(name) + " must have shape (n, 3), got ndim " + std::to_string(a.ndim()));
-  return std::vector<double>(a.data(), a.data() + a.size());
-}
-
-std::vector<Index> indices_from(const IndexArray& a, const char* name, int cols_a, int cols_b = -1) {
-  const bool ok = a.ndim() == 2 && (a.shape(1) == cols_a || a.shape(1) == cols_b);
-  if (!ok && !(a.size() == 0))
-    throw py::value_error(std::string(name) + " must have shape (m, " + std::to_string(cols_a) +
-                          (cols_b > 0 ? " or " + std::to_string(cols_b) : std::string()) + ")");
-  std::vector<Index> out(static_cast<std::size_t>(a.size()));
-  const std::int64_t* d = a.data();
-  for (py::ssize_t i = 0; i < a.size(); ++i) {
-    if (d[i] < INT32_MIN || d[i] > INT32_MAX)
-      throw py::value_error(std::string(name) + " entry " + std::to_string(i) + " = " + std::to_string(d[i]) +
-                            " does not fit a 32-bit index");
-    out[static_cast<std::size_t>(i)] = static_cast<Index>(d[i]);
-  }
-  return out;
-}
 
 py::dict quality_dict(const QualityStats& q) {
   py::dict d;
@@ -83,53 +55,6 @@ TetMesh tetmesh_from(const DoubleArray& points, const IndexArray& tets) {
   return m;
 }
 
-// A mesh's points as an (n, 3) float array and its tets as an (m, nodes_per_tet) int64 array.
-py::array_t<double> points_array(const TetMesh& m) {
-  py::array_t<double> a({static_cast<py::ssize_t>(m.num_points()), static_cast<py::ssize_t>(3)});
-  std::copy(m.xyz.begin(), m.xyz.end(), a.mutable_data());
-  return a;
-}
-py::array_t<std::int64_t> tets_array(const TetMesh& m) {
-  py::array_t<std::int64_t> a({static_cast<py::ssize_t>(m.num_tets()), static_cast<py::ssize_t>(m.nodes_per_tet)});
-  std::copy(m.tet.begin(), m.tet.end(), a.mutable_data());
-  return a;
-}
-
-// Runs `run` (a call of the core) without the GIL, with the options' `cancelled` and `progress`
-// callbacks wired to Python (they take the GIL for each call). Ctrl-C (a pending SIGINT) cancels
-// the run and raises KeyboardInterrupt; `cancel()` returning True cancels it with the core's
-// MeshingError (code "cancelled"). Options: MeshOptions or RefineOptions.
-template <class Options, class Run>
-void run_without_gil(Options& o, const py::object& progress, const py::object& cancel, Run&& run) {
-  std::atomic<bool> interrupted{false};  // set from whichever thread polls (out_of_core.h workers)
-  o.cancelled = [&]() {
-    py::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) {
-      PyErr_Clear();
-      interrupted = true;
-      return true;
-    }
-    return !cancel.is_none() && cancel().cast<bool>();
-  };
-  if (!progress.is_none())
-    o.progress = [&](const std::string& stage, double f) {
-      py::gil_scoped_acquire gil;
-      progress(stage, f);
-    };
-  try {
-    py::gil_scoped_release release;
-    run();
-  } catch (const MeshingError& e) {
-    if (e.code() == ErrorCode::kCancelled && interrupted) {
-      PyErr_SetNone(PyExc_KeyboardInterrupt);
-      throw py::error_already_set();
-    }
-    throw;
-  }
-  o.cancelled = nullptr;
-  o.progress = nullptr;
-}
-
 // The statistics dict of a run in pieces (out_of_core.h PieceStats).
 py::dict piece_stats_dict(const PieceStats& ps, std::int64_t max_piece_triangles) {
   py::dict d;
@@ -157,8 +82,8 @@ const MeshOptions& checked_core_options(const MeshOptions& o) {
   return o;
 }
 
-// The statistics dicts, built from the schemas (core/mesher.h for_each_mesh_stat, fem/fem_mesh.h
-// for_each_fem_stat; refine/quality_refine.h for_each_refine_stat where refine_quality is bound).
+// The statistics dicts, built from the schemas (core/mesher.h for_each_mesh_stat;
+// refine/quality_refine.h for_each_refine_stat where refine_quality is bound).
 py::dict mesh_stats_dict(const MeshStats& st) {
   py::dict d;
   for_each_mesh_stat([&](const char* key, auto member) { d[key] = st.*member; });
@@ -167,60 +92,7 @@ py::dict mesh_stats_dict(const MeshStats& st) {
   return d;
 }
 
-py::dict fem_stats_dict(const fem::FemStats& st) {
-  py::dict d;
-  fem::for_each_fem_stat([&](const char* name, auto member) { d[name] = st.*member; });
-  return d;
-}
-
-// The FEM pipeline (fem/fem_mesh.h, or fem/fem_faces.h in 2D) on a model read by `read`.
-// Returns (points (n, 3), tets (k, 4 or 10; none in 2D), tet_solid (k,), triangles (f, 3 or 6),
-// triangle_face (f,), stats dict, solid names, face names).
-py::tuple mesh_cad(const std::function<cad::CadModel(cad::CadContent)>& read, int dimension,
-                   fem::FemOptions o, const py::object& progress, const py::object& cancel) {
-  if (dimension != 2 && dimension != 3)
-    throw InputError(ErrorCode::kBadArgument, "fem", -1,
-                     "option dimension must be 2 (the faces) or 3 (the solids), got " + std::to_string(dimension));
-  fem::FemMesh fm;
-  fem::FemStats st;
-  run_without_gil(o, progress, cancel, [&]() {
-    if (dimension == 3) {
-      fm = fem::mesh_cad_model(read(cad::CadContent::kSolids), o, &st);
-    } else {
-      fm = fem::mesh_cad_faces(read(cad::CadContent::kFaces), o, &st);
-    }
-  });
-  py::array_t<std::int64_t> tet_solid(static_cast<py::ssize_t>(fm.tet_solid.size()));
-  std::copy(fm.tet_solid.begin(), fm.tet_solid.end(), tet_solid.mutable_data());
-  py::array_t<std::int64_t> tri({static_cast<py::ssize_t>(fm.num_triangles()),
-                                 static_cast<py::ssize_t>(fm.nodes_per_triangle)});
-  std::copy(fm.tri.begin(), fm.tri.end(), tri.mutable_data());
-  py::array_t<std::int64_t> tri_face(static_cast<py::ssize_t>(fm.tri_face.size()));
-  std::copy(fm.tri_face.begin(), fm.tri_face.end(), tri_face.mutable_data());
-  py::dict d = fem_stats_dict(st);
-  d["order"] = o.order;
-  d["dimension"] = dimension;
-  return py::make_tuple(points_array(fm.mesh), tets_array(fm.mesh), tet_solid, tri, tri_face, d,
-                        py::cast(fm.solid_names), py::cast(fm.face_names));
-}
-
 }  // namespace
-
-// An options struct as a Python class, from its schema table (for_each calls f(name, member) for
-// every option): a default constructor, one attribute per option, and the class attribute
-// `names`, the options in the table's order.
-template <class Options, class ForEach>
-py::class_<Options> bind_options(py::module_& m, const char* name, const char* doc, ForEach for_each) {
-  py::class_<Options> c(m, name, doc);
-  c.def(py::init<>());
-  for_each([&](const char* option, auto member) { c.def_readwrite(option, member); });
-  c.def_property_readonly_static("names", [for_each](py::object) {
-    py::list names;
-    for_each([&](const char* option, auto) { names.append(option); });
-    return names;
-  });
-  return c;
-}
 
 PYBIND11_MODULE(_bsptet, m) {
   m.doc() = "FemBspTet C++ core (private; use FemBspTet.core)";
@@ -229,45 +101,9 @@ PYBIND11_MODULE(_bsptet, m) {
   // Core errors reach Python as these types; FemBspTet.core turns them into FemBspTet.errors.
   static py::exception<void> input_error(m, "InputError", PyExc_ValueError);
   static py::exception<void> meshing_error(m, "MeshingError", PyExc_RuntimeError);
-  // A self-intersection raises InputError with `pairs` (k, 2) and `complete` besides `code` and
-  // `index`.
-  static auto raise_self_intersection = [](const SelfIntersectionError& e) {
-    py::array_t<std::int64_t> pairs({static_cast<py::ssize_t>(e.pairs().size()), static_cast<py::ssize_t>(2)});
-    auto out = pairs.mutable_unchecked<2>();
-    for (std::size_t i = 0; i < e.pairs().size(); ++i) {
-      out(static_cast<py::ssize_t>(i), 0) = e.pairs()[i][0];
-      out(static_cast<py::ssize_t>(i), 1) = e.pairs()[i][1];
-    }
-    py::object exc = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
-    exc.attr("code") = error_code_name(e.code());
-    exc.attr("index") = e.index();
-    exc.attr("pairs") = pairs;
-    exc.attr("complete") = e.complete();
-    PyErr_SetObject(input_error.ptr(), exc.ptr());
-    throw py::error_already_set();
-  };
-  py::register_exception_translator([](std::exception_ptr p) {
-    // The Python exception carries the core's error code name and element index.
-    auto raise = [](const py::exception<void>& type, const Error& e) {
-      py::object exc = py::reinterpret_borrow<py::object>(type.ptr())(e.what());
-      exc.attr("code") = error_code_name(e.code());
-      exc.attr("index") = e.index();
-      PyErr_SetObject(type.ptr(), exc.ptr());
-    };
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const SelfIntersectionError& e) {
-      try {
-        raise_self_intersection(e);
-      } catch (py::error_already_set& set) {
-        set.restore();
-      }
-    } catch (const InputError& e) {
-      raise(input_error, e);
-    } catch (const MeshingError& e) {
-      raise(meshing_error, e);
-    }
-  });
+  // Shared with _bsptet_cad (binding_support.h translate_core_errors).
+  static const ErrorTypes error_types{input_error, meshing_error};
+  py::register_exception_translator([](std::exception_ptr p) { translate_core_errors(p, error_types); });
 
   {
     // The core's options schema (core/mesher.h for_each_mesh_option), as a class; picklable (a
@@ -418,7 +254,7 @@ PYBIND11_MODULE(_bsptet, m) {
           py::gil_scoped_release release;
           r = check_surface(s, o);
         } catch (const SelfIntersectionError& e) {
-          raise_self_intersection(e);
+          raise_self_intersection(error_types, e);
         }
         py::array_t<std::int64_t> tri({static_cast<py::ssize_t>(r.tri.size() / 3), static_cast<py::ssize_t>(3)});
         std::copy(r.tri.begin(), r.tri.end(), tri.mutable_data());
@@ -533,74 +369,6 @@ PYBIND11_MODULE(_bsptet, m) {
       "(certified: a lower bound of min det J; invalid: det J <= 0 at a point); with "
       "scaled_jacobian, 'min_scaled_jacobian' (m,): min det J / det J of the straight tet, a lower "
       "bound within 1e-3 (tet10_min_scaled_jacobian).");
-
-  // ---- The FEM pipeline from CAD (fem/fem_mesh.h). ----
-  const char* mesh_cad_doc =
-      "dimension 3: meshes every solid of a CAD model: surface at the size field, exact core, refinement "
-      "with new surface points and tet10 mid-nodes on the CAD, one mesh of all solids (fem/fem_mesh.h); "
-      "dimension 2: every CAD face as triangles (tria6 mid-nodes on the CAD), no tets (fem/fem_faces.h). "
-      "options: a FemOptions (size / min_size: CharacteristicLengthMax / Min in model units, 0: automatic, "
-      "diagonal / 20 and size / 50; order 1 (tet4) or 2 (tet10); grading per unit length; points_per_circle "
-      "for curved faces, 0: off; size_by_face {0-based face: size}). Returns (points (n, 3), tets (k, 4 or 10), "
-      "tet_solid (k,), triangles (f, 3 or 6) of every CAD face once, triangle_face (f,) 0-based CAD "
-      "face, stats dict). Raises InputError (unreadable or unmeshable CAD, bad option) or MeshingError.";
-  {
-    // The options schema (fem/fem_mesh.h for_each_fem_option) and the statistics, as classes.
-    bind_options<fem::FemOptions>(m, "FemOptions",
-                                  "Options of the FEM pipeline from CAD (fem/fem_mesh.h FemOptions); "
-                                  "FreeCAD's CharacteristicLengthMax is size.",
-                                  [](auto&& f) { fem::for_each_fem_option(f); });
-    py::class_<fem::FemStats> stats(m, "FemStats", "Figures of a run of the FEM pipeline (fem/fem_mesh.h FemStats).");
-    stats.def(py::init<>());
-    fem::for_each_fem_stat([&](const char* name, auto member) { stats.def_readonly(name, member); });
-    stats.def("to_dict", &fem_stats_dict, "The figures as the statistics dict (its keys are the field names).");
-  }
-  m.def(
-      "mesh_cad_file",
-      [](const std::string& path, int dimension, const fem::FemOptions& options, py::object progress,
-         py::object cancel) {
-        return mesh_cad([&](cad::CadContent content) { return cad::read_cad_file(path, content); }, dimension,
-                        options, progress, cancel);
-      },
-      py::arg("path"), py::arg("dimension") = 3, py::arg("options") = fem::FemOptions{},
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-      (std::string("A STEP, BREP or IGES file (by extension). ") + mesh_cad_doc).c_str());
-  m.def(
-      "mesh_cad_brep",
-      [](const std::string& brep, int dimension, const fem::FemOptions& options, py::object progress,
-         py::object cancel) {
-        return mesh_cad([&](cad::CadContent content) { return cad::read_brep_string(brep, "BREP string", content); },
-                        dimension, options, progress, cancel);
-      },
-      py::arg("brep"), py::arg("dimension") = 3, py::arg("options") = fem::FemOptions{},
-      py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-      (std::string("A shape in OpenCASCADE's BREP text (FreeCAD's Shape.exportBrepToString()). ") + mesh_cad_doc)
-          .c_str());
-
-  m.def(
-      "cad_face_distances",
-      [](const std::string& path, const DoubleArray& points,
-         py::array_t<int, py::array::c_style | py::array::forcecast> faces) {
-        const std::vector<double> xyz = points_from(points, "points");
-        const std::size_t n = xyz.size() / 3;
-        std::vector<Vec3> pts(n);
-        for (std::size_t i = 0; i < n; ++i) pts[i] = Vec3{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-        std::vector<int> fs(faces.data(), faces.data() + faces.size());
-        cad::FaceDistances d;
-        {
-          const cad::CadModel model = cad::read_cad_file(path);
-          py::gil_scoped_release release;
-          d = cad::distances_to_faces(model, pts, fs);
-        }
-        return py::make_tuple(py::array_t<double>(static_cast<py::ssize_t>(n), d.distance.data()),
-                              py::array_t<int>(static_cast<py::ssize_t>(n), d.face.data()),
-                              py::array_t<double>(static_cast<py::ssize_t>(d.face_tolerance.size()),
-                                                  d.face_tolerance.data()));
-      },
-      py::arg("path"), py::arg("points"), py::arg("faces"),
-      "Distances from points (n, 3) to the faces of the CAD file's model (cad/cad_distance.h): faces (n,) "
-      "0-based, -1 for the nearest face, or empty for all nearest. Returns (distance (n,), face (n,), "
-      "face_tolerance (faces of the model,)).");
 
   m.def(
       "bsp_cells_view",
