@@ -57,8 +57,8 @@ int main(int argc, char** argv) {
     const cad::CadModel model = cad::read_cad_file(path);
     fem::FemStats st;
     const fem::FemMesh mesh = fem::mesh_cad_model(model, options, &st);
-    std::printf("%s: %lld solids %lld faces (%lld shared); h %.4g min %.4g; order %d\n", path.c_str(),
-                (long long)st.solids, (long long)st.faces, (long long)st.shared_faces, st.size, st.min_size,
+    std::printf("%s: %lld solids (meshed as %lld) %lld faces (%lld shared); h %.4g min %.4g; order %d\n", path.c_str(),
+                (long long)st.solids, (long long)st.pieces, (long long)st.faces, (long long)st.shared_faces, st.size, st.min_size,
                 options.order);
     std::printf("  surface: nodes %lld triangles %lld\n", (long long)st.surface_nodes, (long long)st.surface_triangles);
     std::printf("  core: points %lld tets %lld steiner %lld\n", (long long)st.core_points, (long long)st.core_tets,

@@ -380,6 +380,7 @@ CadSurface mesh_cad_surface(const CadModel& model, const CadSurfaceOptions& opti
     fo.grading = field.grading();
     if (field.face_has_local_curvature(f)) fo.local_curvature_points_per_circle = field.points_per_circle();
     fo.max_rounds = options.face_rounds;
+    if (const auto it = options.size_sources.find(f); it != options.size_sources.end()) fo.size_sources = it->second;
     FaceMesh fm;
     try {
       fm = mesh_face(face, loops, fo, static_cast<Index>(out.node_dim.size()));

@@ -543,6 +543,7 @@ FaceMesh FaceMesher::run(const std::vector<std::vector<BoundaryNode>>& loops, In
     }
     index_loops.push_back(std::move(ids));
   }
+  boundary_sizes_.insert(boundary_sizes_.end(), options_.size_sources.begin(), options_.size_sources.end());
   floor_ = options_.min_size;
   for (const auto& bs : boundary_sizes_) floor_ = std::min(floor_, bs.second);
   for (const auto& t : triangulate_polygon(uv, index_loops)) add_tri({t[0], t[1], t[2]});

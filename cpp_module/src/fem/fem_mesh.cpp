@@ -16,8 +16,10 @@
 #include <thread>
 
 #include "bsptet/cad/cad_projection.h"
+#include "bsptet/cad/cad_split.h"
 #include "bsptet/cad/cad_surface.h"
 #include "bsptet/numerics/errors.h"
+#include "bsptet/numerics/predicates.h"
 #include "bsptet/core/mesher.h"
 #include "bsptet/refine/quality_refine.h"
 #include "bsptet/refine/tet10.h"
@@ -52,6 +54,29 @@ std::vector<std::int32_t> fixed_tags_of(const std::vector<std::vector<std::int32
   for (std::int32_t f : faces_of_solid[static_cast<std::size_t>(s)])
     if (solids_of_face[static_cast<std::size_t>(f)] > 1) fixed.push_back(f);
   return fixed;
+}
+
+// The result figures of `out` in `st`: nodes, tets, boundary triangles and the linear tets'
+// dihedral angles (corner_nodes is the caller's).
+void set_figures(const FemMesh& out, FemStats* st) {
+  const int npt = out.mesh.nodes_per_tet;
+  st->nodes = out.mesh.num_points();
+  st->tets = out.mesh.num_tets();
+  st->boundary_triangles = out.num_triangles();
+  std::vector<double> worst(static_cast<std::size_t>(st->tets));
+  for (Index k = 0; k < out.mesh.num_tets(); ++k) {
+    const Index* q = &out.mesh.tet[static_cast<std::size_t>(npt * k)];
+    worst[static_cast<std::size_t>(k)] =
+        tet_min_dihedral_deg(out.mesh.point(q[0]), out.mesh.point(q[1]), out.mesh.point(q[2]), out.mesh.point(q[3]));
+  }
+  if (!worst.empty()) {
+    st->min_dihedral_deg = *std::min_element(worst.begin(), worst.end());
+    std::int64_t below = 0;
+    for (double w : worst) below += w < 10 ? 1 : 0;
+    st->tets_below_10_deg = static_cast<double>(below) / static_cast<double>(worst.size());
+    std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(worst.size() / 2), worst.end());
+    st->median_tet_min_dihedral_deg = worst[worst.size() / 2];
+  }
 }
 
 // One solid's core and refinement (stages 2 and 3), before the merge.
@@ -238,23 +263,30 @@ cad::CadSurfaceOptions cad_surface_options(const FemOptions& options) {
   return so;
 }
 
-FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats) {
-  const auto start = Clock::now();
-  check_fem_options(options);
+namespace {
+
+// Stages 1 to 4 on `model` (the file comment of fem_mesh.h); `given` (with `given_stats`): stage
+// 1's surface when it is already made. Progress goes to `report` (fractions of this run).
+FemMesh mesh_model(const cad::CadModel& model, const FemOptions& options, const cad::CadSurface* given,
+                   const cad::CadSurfaceStats* given_stats, Clock::time_point start, const Report& report,
+                   FemStats* stats,
+                   const std::map<int, std::vector<std::pair<Vec3, double>>>& size_sources = {}) {
   FemStats st;
   st.solids = model.num_solids();
   st.faces = model.num_faces();
+  st.pieces = model.num_solids();
   const int n_solids = model.num_solids();
-  auto report = [&](const std::string& stage, double f) {
-    if (options.progress) options.progress(stage, std::clamp(f, 0.0, 1.0));
-  };
   // ---- 1. Surface. ----
   cad::CadSurfaceOptions so = cad_surface_options(options);
+  so.size_sources = size_sources;
   so.progress = [&](const std::string& stage, double f) { report("surface: " + stage, 0.1 * f); };
   cad::CadSurfaceStats sst;
   auto t = Clock::now();
-  const cad::CadSurface surface = cad::mesh_cad_surface(model, so, &sst);
-  st.seconds_surface = seconds_since(t);
+  cad::CadSurface made;
+  if (!given) made = cad::mesh_cad_surface(model, so, &sst);
+  if (given) sst = *given_stats;
+  const cad::CadSurface& surface = given ? *given : made;
+  st.seconds_surface = given ? sst.seconds : seconds_since(t);
   st.size = sst.size;
   st.min_size = sst.min_size;
   st.surface_nodes = sst.nodes;
@@ -470,29 +502,216 @@ FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, Fe
   }
   st.seconds_merge += seconds_since(t);
 
-  // ---- Figures. ----
   st.corner_nodes = n_corner;
-  st.nodes = out.mesh.num_points();
-  st.tets = out.mesh.num_tets();
-  st.boundary_triangles = out.num_triangles();
-  std::vector<double> worst(static_cast<std::size_t>(st.tets));
-  for (Index k = 0; k < out.mesh.num_tets(); ++k) {
-    const Index* q = &out.mesh.tet[static_cast<std::size_t>(npt * k)];
-    worst[static_cast<std::size_t>(k)] =
-        tet_min_dihedral_deg(out.mesh.point(q[0]), out.mesh.point(q[1]), out.mesh.point(q[2]), out.mesh.point(q[3]));
-  }
-  if (!worst.empty()) {
-    st.min_dihedral_deg = *std::min_element(worst.begin(), worst.end());
-    std::int64_t below = 0;
-    for (double w : worst) below += w < 10 ? 1 : 0;
-    st.tets_below_10_deg = static_cast<double>(below) / static_cast<double>(worst.size());
-    std::nth_element(worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(worst.size() / 2), worst.end());
-    st.median_tet_min_dihedral_deg = worst[worst.size() / 2];
-  }
+  set_figures(out, &st);
   st.seconds_total = seconds_since(start);
   report("done", 1.0);
   if (stats) *stats = st;
   return out;
+}
+
+// Smooths the nodes that lie exactly on the plane x_axis = position inside the merged mesh of a
+// cut model (the cut faces' nodes, fixed while the halves were meshed apart; see cad_split.h),
+// `sweeps` times in node order: each moves towards the centroid of its tets' other corners (all
+// the way, half, a quarter) when its tets stay positive (exact), certified as tet10 with the
+// mid-nodes of its edges at their new midpoints, none gets a worst dihedral below the lower of
+// its old worst and 30 degrees, and their mean worst angle rises. Returns the moves made.
+std::int64_t smooth_cut_nodes(FemMesh& out, int axis, double position, int sweeps) {
+  TetMesh& m = out.mesh;
+  const int npt = m.nodes_per_tet;
+  const Index np = m.num_points(), nk = m.num_tets();
+  std::vector<char> movable(static_cast<std::size_t>(np), 0);
+  for (Index k = 0; k < nk; ++k)
+    for (int c = 0; c < 4; ++c) {
+      const Index v = m.tet[static_cast<std::size_t>(npt * k + c)];
+      const Vec3 p = m.point(v);
+      movable[static_cast<std::size_t>(v)] = (axis == 0 ? p.x : axis == 1 ? p.y : p.z) == position;
+    }
+  for (Index v : out.tri) movable[static_cast<std::size_t>(v)] = 0;  // the boundary stays
+  std::vector<std::vector<Index>> ball(static_cast<std::size_t>(np));
+  for (Index k = 0; k < nk; ++k)
+    for (int c = 0; c < 4; ++c) {
+      const Index v = m.tet[static_cast<std::size_t>(npt * k + c)];
+      if (movable[static_cast<std::size_t>(v)]) ball[static_cast<std::size_t>(v)].push_back(k);
+    }
+  const auto corner = [&](Index k, int c) { return m.point(m.tet[static_cast<std::size_t>(npt * k + c)]); };
+  const auto set_point = [&](Index v, const Vec3& p) {
+    m.xyz[3 * static_cast<std::size_t>(v)] = p.x, m.xyz[3 * static_cast<std::size_t>(v) + 1] = p.y;
+    m.xyz[3 * static_cast<std::size_t>(v) + 2] = p.z;
+  };
+  std::int64_t moves = 0;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    std::int64_t moved = 0;
+    for (Index v = 0; v < np; ++v) {
+      const std::vector<Index>& b = ball[static_cast<std::size_t>(v)];
+      if (b.empty()) continue;
+      const Vec3 old = m.point(v);
+      std::vector<Sign> sign(b.size());
+      double worst_before = 180, mean_before = 0;
+      Vec3 centroid{0, 0, 0};
+      int others = 0;
+      for (std::size_t i = 0; i < b.size(); ++i) {
+        sign[i] = orient3d(corner(b[i], 0), corner(b[i], 1), corner(b[i], 2), corner(b[i], 3));
+        const double q = tet_min_dihedral_deg(corner(b[i], 0), corner(b[i], 1), corner(b[i], 2), corner(b[i], 3));
+        worst_before = std::min(worst_before, q);
+        mean_before += q / static_cast<double>(b.size());
+        for (int c = 0; c < 4; ++c) {
+          const Vec3 p = corner(b[i], c);
+          if (m.tet[static_cast<std::size_t>(npt * b[i] + c)] == v) continue;
+          centroid.x += p.x, centroid.y += p.y, centroid.z += p.z;
+          ++others;
+        }
+      }
+      if (others == 0) continue;
+      centroid = {centroid.x / others, centroid.y / others, centroid.z / others};
+      // The mid-nodes of v's edges, to put back when a move is refused.
+      std::vector<std::pair<Index, Vec3>> mids;
+      if (npt == 10)
+        for (Index k : b)
+          for (int e = 0; e < 6; ++e) {
+            const Index a = m.tet[static_cast<std::size_t>(10 * k + kTetEdge[e][0])];
+            const Index c = m.tet[static_cast<std::size_t>(10 * k + kTetEdge[e][1])];
+            if (a == v || c == v) mids.emplace_back(m.tet[static_cast<std::size_t>(10 * k + 4 + e)], Vec3{});
+          }
+      for (auto& [mid, p] : mids) p = m.point(mid);
+      bool accepted = false;
+      for (double f : {1.0, 0.5, 0.25}) {
+        const Vec3 p{old.x + f * (centroid.x - old.x), old.y + f * (centroid.y - old.y), old.z + f * (centroid.z - old.z)};
+        set_point(v, p);
+        bool ok = true;
+        double mean = 0;
+        for (std::size_t i = 0; i < b.size() && ok; ++i) {
+          ok = orient3d(corner(b[i], 0), corner(b[i], 1), corner(b[i], 2), corner(b[i], 3)) == sign[i] &&
+               sign[i] != Sign::kZero;
+          const double q = tet_min_dihedral_deg(corner(b[i], 0), corner(b[i], 1), corner(b[i], 2), corner(b[i], 3));
+          ok = ok && q >= std::min(worst_before, 30.0);
+          mean += q / static_cast<double>(b.size());
+        }
+        ok = ok && mean > mean_before;
+        if (ok && npt == 10) {
+          for (Index k : b)
+            for (int e = 0; e < 6; ++e) {
+              const Index a = m.tet[static_cast<std::size_t>(10 * k + kTetEdge[e][0])];
+              const Index c = m.tet[static_cast<std::size_t>(10 * k + kTetEdge[e][1])];
+              if (a == v || c == v) set_point(m.tet[static_cast<std::size_t>(10 * k + 4 + e)], midpoint(m.point(a), m.point(c)));
+            }
+          for (std::size_t i = 0; i < b.size() && ok; ++i) {
+            double x[30];
+            for (int j = 0; j < 10; ++j) {
+              const Vec3 q = m.point(m.tet[static_cast<std::size_t>(10 * b[i] + j)]);
+              x[3 * j] = q.x, x[3 * j + 1] = q.y, x[3 * j + 2] = q.z;
+            }
+            ok = certify_tet10(x) == Tet10Validity::kCertified;
+          }
+          if (!ok)
+            for (const auto& [mid, q] : mids) set_point(mid, q);
+        }
+        if (ok) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        set_point(v, old);
+        continue;
+      }
+      ++moved;
+    }
+    moves += moved;
+    if (moved == 0) break;
+  }
+  return moves;
+}
+
+// A solid's tets estimated from its surface triangles and its volume at the size h, as the cut's
+// plane balances them (cad_split.h): kTetsPerTriangle per triangle (graded meshes of parts with
+// small features: about 4 over the CAD corpus) plus the tets of edge h, h^3 / (6 sqrt 2) each,
+// that fill the volume.
+double estimated_tets(std::size_t triangles, double volume, double h) {
+  return cad::kTetsPerTriangle * static_cast<double>(triangles) + volume / (h * h * h / (6 * std::sqrt(2.0)));
+}
+
+// A model of one solid is cut in two when the estimate reaches this: below it the cut, the second
+// surface and the seam cost about what the second thread saves.
+constexpr double kCutFromTets = 20000;
+
+}  // namespace
+
+FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats) {
+  const auto start = Clock::now();
+  check_fem_options(options);
+  const auto report = [&](const std::string& stage, double f) {
+    if (options.progress) options.progress(stage, std::clamp(f, 0.0, 1.0));
+  };
+  if (model.num_solids() != 1) return mesh_model(model, options, nullptr, nullptr, start, report, stats);
+
+  // One solid: its surface first; a solid big enough is cut in two (cad_split.h) and the halves
+  // are meshed as two solids sharing the cut, at the same time (fem_mesh.h).
+  cad::CadSurfaceOptions so = cad_surface_options(options);
+  so.progress = [&](const std::string& stage, double f) { report("surface: " + stage, 0.05 * f); };
+  cad::CadSurfaceStats sst;
+  const cad::CadSurface surface = cad::mesh_cad_surface(model, so, &sst);
+  const double volume = cad::enclosed_volume(surface, 0);
+  if (estimated_tets(surface.solid_tag[0].size(), volume, sst.size) >= kCutFromTets) {
+    const auto t = Clock::now();
+    const cad::CutPlane plane = cad::choose_cut_plane(model, surface, sst.size);
+    cad::CadSplit split = cad::split_by_plane(model, plane);
+    if (split.cut) {
+      FemOptions o = options;
+      o.size_by_face.clear();
+      for (const auto& [face, size] : options.size_by_face)
+        for (std::size_t g = 0; g < split.face_origin.size(); ++g)
+          if (split.face_origin[g] == face) o.size_by_face[static_cast<int>(g)] = size;
+      // The cut faces are meshed at the sizes the volume will have there.
+      std::map<int, std::vector<std::pair<Vec3, double>>> sources;
+      const auto cut_sources = cad::cut_size_sources(surface, plane, sst.size, options.grading);
+      for (std::size_t g = 0; g < split.face_origin.size(); ++g)
+        if (split.face_origin[g] < 0) sources[static_cast<int>(g)] = cut_sources;
+      FemStats st;
+      FemMesh out;
+      const double seconds_before = sst.seconds + seconds_since(t);
+      try {
+        out = mesh_model(split.model, o, nullptr, nullptr, start,
+                         [&](const std::string& stage, double f) { report(stage, 0.05 + 0.95 * f); }, &st, sources);
+      } catch (const Error& e) {
+        // The halves could not be meshed (a seam OpenCASCADE made badly): the whole solid is.
+        if (e.code() == ErrorCode::kCancelled) throw;
+        return mesh_model(model, options, &surface, &sst, start, report, stats);
+      }
+      // The halves' tags as the model's: tets to the solid, triangles to their original face,
+      // the cut's triangles (inside the solid) dropped.
+      for (auto& s : out.tet_solid) s = split.solid_origin[static_cast<std::size_t>(s)];
+      const int npf = out.nodes_per_triangle;
+      std::vector<Index> tri;
+      std::vector<std::int32_t> tri_face;
+      for (Index f = 0; f < out.num_triangles(); ++f) {
+        const int origin = split.face_origin[static_cast<std::size_t>(out.tri_face[static_cast<std::size_t>(f)])];
+        if (origin < 0) continue;
+        tri.insert(tri.end(), out.tri.begin() + npf * f, out.tri.begin() + npf * (f + 1));
+        tri_face.push_back(origin);
+      }
+      out.tri = std::move(tri);
+      out.tri_face = std::move(tri_face);
+      out.solid_names = model.solid_names;
+      out.face_names = model.face_names;
+      // The cut's nodes were fixed while the pieces were meshed apart; inside the merged mesh
+      // they are free.
+      const auto ts = Clock::now();
+      st.cut_nodes_smoothed = smooth_cut_nodes(out, plane.axis, plane.position, 3);
+      set_figures(out, &st);
+      st.seconds_merge += seconds_since(ts);
+      st.seconds_total = seconds_since(start);
+      st.solids = model.num_solids();
+      st.faces = model.num_faces();
+      st.shared_faces = 0;
+      st.boundary_triangles = out.num_triangles();
+      st.seconds_surface += seconds_before;
+      if (stats) *stats = st;
+      return out;
+    }
+  }
+  return mesh_model(model, options, &surface, &sst, start,
+                    [&](const std::string& stage, double f) { report(stage, std::max(0.05, f)); }, stats);
 }
 
 CadDistance measure_cad_distance(const cad::CadModel& model, const FemMesh& mesh) {

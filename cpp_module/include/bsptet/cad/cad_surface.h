@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +37,8 @@ namespace bsptet::cad {
 struct CadSurfaceOptions {
   SizeOptions size;
   int face_rounds = 20;  ///< rounds of local operations per face at most (face_mesher.h)
+  /// Per face (0-based), sizes set from outside it (FaceMeshOptions::size_sources).
+  std::map<int, std::vector<std::pair<Vec3, double>>> size_sources;
   /// Called with (stage, fraction in [0, 1]); may be empty.
   std::function<void(const std::string&, double)> progress;
   /// Polled between faces; return true to stop (throws MeshingError with code kCancelled).

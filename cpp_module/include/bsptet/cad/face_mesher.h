@@ -40,6 +40,7 @@
 #pragma once
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include <TopoDS_Face.hxx>
@@ -66,6 +67,9 @@ struct FaceMeshOptions {
   /// > 0: the size at a node is also at most the local curvature size there (size_field.h)
   double local_curvature_points_per_circle = 0;
   int max_rounds = 20;     ///< rounds of split / collapse / flip / smooth at most
+  /// Sizes set from outside the face: points with their sizes, graded like the boundary nodes'
+  /// (a face that cuts a solid takes the sizes the volume will have there: cad_split.h).
+  std::vector<std::pair<Vec3, double>> size_sources;
 };
 
 struct FaceMesh {

@@ -85,6 +85,9 @@ struct FemOptions {
 
 struct FemStats {
   std::int64_t solids = 0, faces = 0;
+  /// Solids meshed: the model's, or the pieces of a model of one solid cut by a plane
+  /// (cad/cad_split.h), and the cut's nodes smoothed once the pieces are merged.
+  std::int64_t pieces = 0, cut_nodes_smoothed = 0;
   double size = 0, min_size = 0;  ///< the size field's h and floor (automatic ones resolved)
   // Surface (stage 1).
   std::int64_t surface_nodes = 0, surface_triangles = 0;
@@ -192,6 +195,8 @@ template <class F>
 void for_each_fem_stat(F&& f) {
   f("solids", &FemStats::solids);
   f("faces", &FemStats::faces);
+  f("pieces", &FemStats::pieces);
+  f("cut_nodes_smoothed", &FemStats::cut_nodes_smoothed);
   f("size", &FemStats::size);
   f("min_size", &FemStats::min_size);
   f("surface_nodes", &FemStats::surface_nodes);
