@@ -356,7 +356,9 @@ def mesh_summary(source, outputs, mesh, stats, groups):
     if fem_path:
         lines.append(f"read     {source}: {_count(stats['solids'])} solid(s), "
                      f"{_count(stats['faces'])} CAD faces; meshed at size {stats['size']:.4g} "
-                     f"(min {stats['min_size']:.3g})")
+                     f"(min {stats['min_size']:.3g})"
+                     + (f" in {int(stats['pieces'])} pieces" if stats.get("pieces", 0) >
+                        stats["solids"] else ""))
     else:
         lines.append(f"read     {source}: {_count(stats.get('input_points', 0))} points, "
                      f"{_count(stats.get('input_triangles', 0))} triangles")
@@ -405,8 +407,15 @@ def mesh_summary(source, outputs, mesh, stats, groups):
             [(k, v) for k, v in parts if k == "writing"]
     other = total - sum(v for _, v in parts)
     timing = ", ".join(f"{k} {v:.2f}" for k, v in parts)
-    lines.append(f"time     {total:.2f} s" + (f" ({timing}, the rest {other:.2f})"
-                                              if parts else ""))
+    if fem_path and stats.get("pieces", stats.get("solids", 1)) > 1 and other < 0:
+        # the solids (or the pieces of a cut solid) were meshed at the same time: their stage
+        # seconds add up to more than the run
+        timing += f"; the core and refine seconds add up over the {int(stats['pieces'])} pieces " \
+                  "meshed at the same time"
+        lines.append(f"time     {total:.2f} s ({timing})")
+    else:
+        lines.append(f"time     {total:.2f} s" + (f" ({timing}, the rest {other:.2f})"
+                                                  if parts else ""))
     return "\n".join(lines)
 
 
@@ -689,8 +698,9 @@ def build_parser():
                         "their points become interior nodes); the core's mesh only: no --size, "
                         "quality or --order 2")
     m.add_argument("--workers", metavar="N", type=int, default=None,
-                   help="a CAD file: mesh N solids at a time, one thread each (default: every "
-                        "core; the mesh is the same for any N). A triangle surface: mesh it in "
+                   help="a CAD file: mesh N solids at a time, one thread each, a single big "
+                        "solid cut in two or three pieces first (default: every core; the mesh is "
+                        "the same for any N). A triangle surface: mesh it in "
                         "about N pieces, N at a time (default: every core for a surface of at "
                         "least 200,000 triangles meshed by the core alone, else 1); the mesh "
                         "depends on N, not on where the pieces ran")

@@ -106,8 +106,9 @@ class MeshParameters:
                     (on the CAD part, where installed) and report their counts, angles, times.
     dimension:      3: the solids as tets; 2: every CAD face as triangles (tria3 / tria6, shell
                     and plane analyses); 0: from the shape (3 if it holds a solid, else 2).
-    workers:        solids meshed at the same time, one thread each; 0 = every core (the mesh
-                    is the same for any value).
+    workers:        solids meshed at the same time, one thread each, a part of one big solid
+                    cut in two or three pieces first; 0 = every core (the mesh is the same for
+                    any value).
     """
 
     max_size: float = 0.0

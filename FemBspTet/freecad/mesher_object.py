@@ -76,8 +76,8 @@ PARAMETER_PROPERTIES = (
      "bound, on this mesh's surface), Gmsh and Netgen (on the CAD part, where installed) and "
      "show their counts, angles and times", True),
     ("App::PropertyInteger", "Workers", PARAMS_GROUP,
-     "Solids meshed at the same time, one processor core each (0 = every core); the mesh is "
-     "the same for any value", 0),
+     "Solids meshed at the same time, one processor core each (0 = every core); a part of one "
+     "big solid is cut in two or three pieces first; the mesh is the same for any value", 0),
 )
 
 #: (type, name, tooltip) of every read-only result property.

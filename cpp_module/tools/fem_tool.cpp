@@ -8,7 +8,7 @@
 // seconds per stage. --optimize-rounds: FemOptions::optimize_rounds. --vtu writes the mesh (tets and CAD face triangles, fem_io.h); --off writes
 // the CAD face triangles' corners as one surface; --distance also measures how far the nodes of
 // the face triangles lie from their CAD faces (slow: one OpenCASCADE extrema search per node and
-// face). --workers N: solids meshed at the same time (FemOptions::workers; default every core).
+// face). --workers N: solids (pieces of a cut solid) meshed at the same time (FemOptions::workers; default every core).
 // Exit status: 0, 2 for bad input, 1 otherwise.
 #include <cstdio>
 #include <cstdlib>

@@ -631,10 +631,6 @@ double estimated_tets(std::size_t triangles, double volume, double h) {
   return cad::kTetsPerTriangle * static_cast<double>(triangles) + volume / (h * h * h / (6 * std::sqrt(2.0)));
 }
 
-// A model of one solid is cut in two when the estimate reaches this: below it the cut, the second
-// surface and the seam cost about what the second thread saves.
-constexpr double kCutFromTets = 20000;
-
 }  // namespace
 
 FemMesh mesh_cad_model(const cad::CadModel& model, const FemOptions& options, FemStats* stats) {

@@ -366,6 +366,37 @@ TEST_P(CadPipelineOrder, SolidsMeshedAtTheSameTimeGiveTheSameMesh) {
   }
 }
 
+// A model of one solid big enough is cut by a plane (cad/cad_split.h) and its pieces meshed at
+// the same time: the mesh is one solid's (every tet Solid1, every face triangle on one of the
+// model's faces, the boundary exactly those triangles: nothing left of the cut), valid and on the
+// CAD as any, the cut's nodes smoothed once merged, and the same for 1 and 2 workers.
+TEST_P(CadPipelineOrder, OneBigSolidIsCutAndItsPiecesMergeIntoOneMesh) {
+  const cad::CadModel model = cad::read_cad_file(data("cad/bracket.step"));
+  std::vector<fem::FemMesh> meshes;
+  for (int workers : {1, 2}) {
+    fem::FemOptions o;
+    o.order = GetParam();
+    o.size = model.diagonal() / 40;
+    o.workers = workers;
+    fem::FemStats st;
+    meshes.push_back(fem::mesh_cad_model(model, o, &st));
+    EXPECT_EQ(st.solids, 1);
+    EXPECT_GE(st.pieces, 2);
+    EXPECT_GT(st.cut_nodes_smoothed, 0);
+    EXPECT_EQ(st.faces, model.num_faces());
+    EXPECT_EQ(st.shared_faces, 0);
+    expect_valid_fem_mesh(model, meshes.back(), st, o.order);
+    EXPECT_EQ(std::count(meshes.back().tet_solid.begin(), meshes.back().tet_solid.end(), 0),
+              static_cast<std::ptrdiff_t>(meshes.back().tet_solid.size()));
+    EXPECT_EQ(meshes.back().face_names, model.face_names);
+    EXPECT_EQ(meshes.back().solid_names, model.solid_names);
+  }
+  EXPECT_EQ(meshes[1].mesh.xyz, meshes[0].mesh.xyz);
+  EXPECT_EQ(meshes[1].mesh.tet, meshes[0].mesh.tet);
+  EXPECT_EQ(meshes[1].tri, meshes[0].tri);
+  EXPECT_EQ(meshes[1].tri_face, meshes[0].tri_face);
+}
+
 INSTANTIATE_TEST_SUITE_P(Orders, CadPipelineOrder, ::testing::Values(1, 2),
                          [](const ::testing::TestParamInfo<int>& info) { return "order" + std::to_string(info.param); });
 
