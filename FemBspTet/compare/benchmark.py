@@ -202,10 +202,12 @@ def environment():
 
 def _short_message(message):
     """``message`` without the comparison's temporary folder (``fembsptet_compare_*/`` in the
-    system's temporary directory)."""
+    system's temporary directory) and with paths inside the current directory made relative to
+    it (a report names no machine's folders)."""
 
     folder = re.escape(os.path.join(tempfile.gettempdir(), "fembsptet_compare_"))
-    return re.sub(folder + r"[^/\s]*/", "", message)
+    message = re.sub(folder + r"[^/\s]*/", "", message)
+    return message.replace(os.getcwd() + os.sep, "")
 
 
 def _cell_text(row, key):
@@ -222,7 +224,7 @@ def report_markdown(entries, command="", png_name=None, env=None, repeats=1):
     sizes = {e.comparison.size is None for e in entries if e.comparison is not None}
     lines += ["", "How to read it:",
               "- Each mesher ran as its own process, one at a time; seconds is that process's "
-              "wall time (start-up included: our worker starts Python and numpy, about 0.15 s), "
+              "wall time (start-up included: our worker starts Python and numpy, about 0.1 s), "
               "peak MB its peak resident memory (GNU time)." +
               (f" A run shorter than {REPEAT_BELOW_SECONDS:g} s was made {repeats} times, the "
                "meshers taking turns: its seconds are the median (its other figures, the first "

@@ -60,7 +60,7 @@ from .ours_worker import ours_mesh_path
 
 OURS, TETGEN_PY, TETGEN_PQ, GMSH = "ours", "tetgen-pY", "tetgen-pq", "gmsh"
 #: Our core alone as a native program (``build/cpp_module/bsptet_mesh --no-check``), for timing
-#: the core beside TetGen's own program without our Python worker's start-up (about 0.15 s) and
+#: the core beside TetGen's own program without our Python worker's start-up (about 0.1 s) and
 #: in-process check; its mesh is read back and checked here like every other. Opt-in: not in
 #: MESHERS, and only without a size (the core makes no quality mesh).
 OURS_NATIVE = "ours-native"

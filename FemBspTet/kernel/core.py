@@ -15,6 +15,7 @@ conditions are listed in ``cpp_module/include/bsptet/mesh/mesh_check.h``.
 """
 
 import contextlib
+import importlib
 
 import numpy as np
 
@@ -56,30 +57,27 @@ def _checked(reference, mesh, what, source=None):
     return report
 
 
-def native():
-    """The compiled core (no OpenCASCADE), with a message that says how to build it when it is
+def _extension(name, what):
+    """The compiled module FemBspTet.<name>, with a message that says how to build it when it is
     missing."""
     try:
-        from .. import _bsptet
+        return importlib.import_module(f"..{name}", __package__)
     except ImportError as exc:  # pragma: no cover - depends on the build
         raise InternalError(
-            "the C++ core FemBspTet._bsptet is not built or does not load "
+            f"{what} FemBspTet.{name} is not built or does not load "
             f"({exc}); run scripts/setup.sh (it installs what is missing and builds the core)"
         ) from exc
-    return _bsptet
+
+
+def native():
+    """The compiled core (no OpenCASCADE)."""
+    return _extension("_bsptet", "the C++ core")
 
 
 def native_cad():
     """The compiled FEM pipeline from CAD, the extension that loads OpenCASCADE (only the CAD
     paths import it, so a triangle surface meshes without it)."""
-    try:
-        from .. import _bsptet_cad
-    except ImportError as exc:  # pragma: no cover - depends on the build
-        raise InternalError(
-            "the C++ FEM pipeline FemBspTet._bsptet_cad is not built or does not load "
-            f"({exc}); run scripts/setup.sh (it installs what is missing and builds the core)"
-        ) from exc
-    return _bsptet_cad
+    return _extension("_bsptet_cad", "the C++ FEM pipeline")
 
 
 def check_mesh(surface: Surface, mesh: TetMesh, max_messages: int = 20, compute_quality=True):

@@ -20,6 +20,8 @@
 #include <TopoDS_Face.hxx>
 #include <gp_Pln.hxx>
 
+#include "bsptet/numerics/errors.h"
+
 namespace bsptet::cad {
 namespace {
 
@@ -307,6 +309,8 @@ CadSplit split_by_plane(const CadModel& model, const CutPlane& plane) {
     out.face_origin = std::move(face_origin);
     out.solid_origin.assign(static_cast<std::size_t>(out.model.num_solids()), 0);
   } catch (const Standard_Failure&) {
+    return CadSplit{};
+  } catch (const Error&) {  // make_cad_model refused the result (a face outside every solid)
     return CadSplit{};
   }
   return out;
