@@ -39,6 +39,10 @@ P3 node(const CadSurface& s, Index i) {
   return {s.xyz[k], s.xyz[k + 1], s.xyz[k + 2]};
 }
 
+double length(const P3& p, const P3& q) {
+  return std::sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]));
+}
+
 // The integral of (x_a - c) n_a over triangle (x, y, z) (outward): the a-component of its vector
 // area, 1/2 (y - x) x (z - x), times the mean of x_a - c.
 double triangle_integral(const P3& x, const P3& y, const P3& z, int a, double c) {
@@ -143,8 +147,7 @@ CutPlane choose_cut_plane(const CadModel& model, const CadSurface& surface, doub
     for (std::size_t t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k) {
         const Index u = tri[3 * t + static_cast<std::size_t>(k)], v = tri[3 * t + static_cast<std::size_t>((k + 1) % 3)];
-        const P3 p = node(surface, u), q = node(surface, v);
-        const double l = std::sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]));
+        const double l = length(node(surface, u), node(surface, v));
         for (Index w : {u, v}) sum[static_cast<std::size_t>(w)] += l, ++count[static_cast<std::size_t>(w)];
       }
     for (Index i = 0; i < nn; ++i)
@@ -154,10 +157,18 @@ CutPlane choose_cut_plane(const CadModel& model, const CadSurface& surface, doub
       }
   }
   const double tet_volume = size * size * size / (6 * std::sqrt(2.0));
+  std::vector<double> tmin(nt), tmax(nt);  // each triangle's extent along the axis
   for (int a = 0; a < 3; ++a) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (Index i = 0; i < nn; ++i) lo = std::min(lo, node(surface, i)[a]), hi = std::max(hi, node(surface, i)[a]);
     if (!(hi > lo)) continue;
+    for (std::size_t t = 0; t < nt; ++t) {
+      tmin[t] = std::numeric_limits<double>::infinity(), tmax[t] = -tmin[t];
+      for (int j = 0; j < 3; ++j) {
+        const double x = node(surface, tri[3 * t + static_cast<std::size_t>(j)])[a];
+        tmin[t] = std::min(tmin[t], x), tmax[t] = std::max(tmax[t], x);
+      }
+    }
     for (int k = 0; k < kPositions; ++k) {
       const double c = lo + (hi - lo) * (k + 0.5) / kPositions;
       // The share of the work below: triangles by their centroid, and the volume.
@@ -166,6 +177,7 @@ CutPlane choose_cut_plane(const CadModel& model, const CadSurface& surface, doub
       double volume_below = 0, area_below = 0;
       std::int64_t triangles_below = 0;
       for (std::size_t t = 0; t < nt; ++t) {
+        if (tmin[t] >= c) continue;  // wholly above: nothing below, centroid above
         const P3 p = node(surface, tri[3 * t]), q = node(surface, tri[3 * t + 1]), r = node(surface, tri[3 * t + 2]);
         volume_below += below_integral(p, q, r, a, c, &area_below);
         triangles_below += p[a] + q[a] + r[a] < 3 * c;
@@ -182,20 +194,14 @@ CutPlane choose_cut_plane(const CadModel& model, const CadSurface& surface, doub
       bool ok = true;
       std::set<std::int32_t> crossed;
       for (std::size_t t = 0; t < nt && ok; ++t) {
-        double tmin = std::numeric_limits<double>::infinity(), tmax = -tmin;
-        for (int j = 0; j < 3; ++j) {
-          const double x = node(surface, tri[3 * t + static_cast<std::size_t>(j)])[a];
-          tmin = std::min(tmin, x), tmax = std::max(tmax, x);
-        }
-        if (tmin > c || tmax < c) continue;
+        if (tmin[t] > c || tmax[t] < c) continue;
         crossed.insert(tag[t]);
         ok = std::abs(normal[t][static_cast<std::size_t>(a)]) <= min_cos;
       }
       for (std::size_t i = 0; i < cad_edge_segments.size() && ok; ++i) {
         const P3 p = node(surface, cad_edge_segments[i][0]), q = node(surface, cad_edge_segments[i][1]);
         if ((p[a] - c) * (q[a] - c) > 0) continue;
-        const double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
-        const double l = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const double l = length(p, q);
         ok = l > 0 && std::abs(q[a] - p[a]) >= min_sin * l;
       }
       if (!ok) continue;
@@ -231,8 +237,8 @@ std::vector<std::pair<Vec3, double>> cut_size_sources(const CadSurface& surface,
   for (std::size_t k = 0; k + 2 < tri.size(); k += 3) {
     double mean = 0;
     for (int i = 0; i < 3; ++i) {
-      const P3 p = node(surface, tri[k + static_cast<std::size_t>(i)]), q = node(surface, tri[k + static_cast<std::size_t>((i + 1) % 3)]);
-      mean += std::sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2])) / 3;
+      mean += length(node(surface, tri[k + static_cast<std::size_t>(i)]),
+                     node(surface, tri[k + static_cast<std::size_t>((i + 1) % 3)])) / 3;
     }
     for (int i = 0; i < 3; ++i) {
       double& s = t[static_cast<std::size_t>(tri[k + static_cast<std::size_t>(i)])];

@@ -283,8 +283,10 @@ FemMesh mesh_model(const cad::CadModel& model, const FemOptions& options, const 
   cad::CadSurfaceStats sst;
   auto t = Clock::now();
   cad::CadSurface made;
-  if (!given) made = cad::mesh_cad_surface(model, so, &sst);
-  if (given) sst = *given_stats;
+  if (given)
+    sst = *given_stats;
+  else
+    made = cad::mesh_cad_surface(model, so, &sst);
   const cad::CadSurface& surface = given ? *given : made;
   st.seconds_surface = given ? sst.seconds : seconds_since(t);
   st.size = sst.size;
